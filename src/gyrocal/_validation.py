@@ -1,0 +1,46 @@
+"""Argument checks shared by the public entry points.
+
+Messages name the argument, what was received and what would be accepted.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import InputError, NonFiniteInputError
+
+
+def finite_array(name: str, value, *, shape_tail: tuple[int, ...] = (), ndim: int | None = None) -> np.ndarray:
+    """Return `value` as a float array, checking its trailing shape and finiteness."""
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} must be numeric, got {type(value).__name__}") from exc
+    if ndim is not None and arr.ndim != ndim:
+        raise InputError(f"{name} must have {ndim} dimension(s), got shape {arr.shape}")
+    if shape_tail and arr.shape[arr.ndim - len(shape_tail):] != shape_tail:
+        want = "(..., " + ", ".join(map(str, shape_tail)) + ")"
+        raise InputError(f"{name} must have shape {want}, got {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        bad = np.argwhere(~np.isfinite(arr))
+        raise NonFiniteInputError(
+            f"{name} holds {len(bad)} NaN or infinite value(s), first at index {tuple(int(i) for i in bad[0])}; "
+            "drop or fill those samples first"
+        )
+    return arr
+
+
+def vector3(name: str, value) -> np.ndarray:
+    """Return `value` as a finite float array of shape (3,)."""
+    return finite_array(name, value, shape_tail=(3,), ndim=1)
+
+
+def positive(name: str, value: float) -> float:
+    """Return `value` as a float, refusing anything that is not finite and > 0."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} must be a number, got {value!r}") from exc
+    if not np.isfinite(v) or v <= 0:
+        raise InputError(f"{name} must be finite and > 0, got {value!r}")
+    return v

@@ -1,0 +1,25 @@
+"""Estimators of the seed 000 scale-bias model.
+
+Each estimator holds only its configuration; ``fit`` returns a frozen
+:class:`FitResult` and ``fit_batch`` a :class:`BatchFit` over many gyros.
+"""
+
+from ._result import BatchFit, FitResult, Method
+from .algorithm1 import Algorithm1, algorithm1_batch
+from .first_moment import FirstMoment, first_moment_batch
+from .paper_lm import PaperLM, paper_lm_batch
+
+__all__ = [
+    "Algorithm1", "PaperLM", "FirstMoment", "FitResult", "BatchFit", "Method",
+    "algorithm1_batch", "paper_lm_batch", "first_moment_batch", "make_estimator",
+]
+
+
+def make_estimator(method: Method, **options):
+    """The estimator for a method name: ``first-moment`` (default), ``algorithm1`` or ``lm``."""
+    from ..errors import InputError
+
+    table = {"first-moment": FirstMoment, "algorithm1": Algorithm1, "lm": PaperLM}
+    if method not in table:
+        raise InputError(f"method={method!r} is not one of {', '.join(table)}")
+    return table[method](**options)

@@ -1,0 +1,201 @@
+"""The first-moment estimator (SPEC, Method S): unbiased, with a data-driven covariance.
+
+Rotation windows give norm equations on the window mean,
+
+    |diag(k) (m_mean + b)| = rate,                  rate = angle / T, or the known speed,
+
+and static windows give vector equations ``diag(k) (m_mean + b) = 0``. Squaring the
+window mean instead of averaging squares (seed 000 eq. 8) keeps the noise power out
+of the equations, so the estimate is unbiased.
+
+Rows are weighted by the square root of the window's sample count (equal per-sample
+noise on every axis); the covariance is a sandwich that uses the per-axis noise
+actually measured, so it stays right when the axes differ.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import DegenerateDesignError, InputError
+from ..observations import ObservationSet
+from ._checks import require_converged, require_count, require_full_rank, require_positive_k2
+from ._lm import batched_lm
+from ._result import BatchFit, FitResult
+
+__all__ = ["FirstMoment", "first_moment_batch", "residuals_and_jacobian", "sandwich_covariance", "estimate_noise_var"]
+
+PARAM_NAMES = ("kx", "ky", "kz", "bx", "by", "bz")
+
+
+def residuals_and_jacobian(p: np.ndarray, obs: ObservationSet) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Weighted residuals (B, m), Jacobian (B, m, 6) and each row's noise sensitivity.
+
+    Rows are the rotation windows, then three rows per static window, each weighted
+    by ``sqrt(count)``. The third output (B, m, 3) is the derivative of a weighted row
+    with respect to one sample's reading: a window mean of ``n`` samples has variance
+    ``sigma^2 / n`` and the row weight is ``sqrt(n)``, so the two cancel. It feeds
+    :func:`sandwich_covariance`.
+    """
+    k, b = p[:, None, :3], p[:, None, 3:]
+    rot, sta = ~obs.static, obs.static
+    w_rot = np.sqrt(obs.count[rot])[None, :, None]
+    v = k * (obs.mean[:, rot] + b)  # (B, n_rot, 3)
+    norm = np.linalg.norm(v, axis=-1, keepdims=True)
+    u = v / norm
+    r_rot = (norm[..., 0] - obs.rate[:, rot]) * w_rot[..., 0]
+    J_rot = np.concatenate([u * (obs.mean[:, rot] + b), u * k], axis=-1) * w_rot
+    S_rot = u * k
+
+    ms = obs.mean[:, sta] + b  # (B, n_sta, 3)
+    w_sta = np.sqrt(obs.count[sta])[None, :, None]
+    r_sta = (k * ms * w_sta).reshape(len(p), -1)
+    eye = np.eye(3)
+    k_sta = np.broadcast_to(k, ms.shape)
+    J_sta = np.concatenate([eye * ms[..., None], eye * k_sta[..., None]], axis=-1) * w_sta[..., None]
+    S_sta = eye * k_sta[..., None]
+    B = len(p)
+    return (
+        np.concatenate([r_rot, r_sta], axis=1),
+        np.concatenate([J_rot, J_sta.reshape(B, -1, 6)], axis=1),
+        np.concatenate([S_rot, S_sta.reshape(B, -1, 3)], axis=1),
+    )
+
+
+def estimate_noise_var(obs: ObservationSet) -> np.ndarray:
+    """Per-axis per-sample noise variance (B, 3) [reading units^2], from the data.
+
+    Static windows are used when there are any. Otherwise each rotation window lends
+    its two non-rotating axes, whose first differences hold sensor noise but no
+    speed jitter.
+    """
+    weights = obs.count * obs.static
+    if weights.sum() > 0:
+        w = np.broadcast_to(weights[None, :, None], obs.noise_var.shape)
+    else:
+        dominant = np.abs(obs.mean).argmax(axis=-1)  # (B, n)
+        w = obs.count[None, :, None] * (dominant[..., None] != np.arange(3))
+    total = w.sum(axis=1)
+    pooled = (w * obs.noise_var).sum(axis=1) / np.where(total > 0, total, 1.0)
+    # An axis never seen off-rotation borrows the mean of the others.
+    fallback = pooled.sum(axis=1, keepdims=True) / np.maximum((total > 0).sum(axis=1, keepdims=True), 1)
+    return np.where(total > 0, pooled, fallback)
+
+
+def sandwich_covariance(J: np.ndarray, S: np.ndarray, noise_var: np.ndarray) -> np.ndarray:
+    """Covariance (B, 6, 6) of the weighted fit with per-axis noise `noise_var` (B, 3).
+
+    ``H^-1 J^T Sigma J H^-1`` with ``H = J^T J`` and ``Sigma`` the row covariance implied
+    by independent per-axis white noise of each window mean.
+    """
+    H = np.einsum("bmi,bmj->bij", J, J)
+    # Rows of one static window share no noise across axes, and windows are independent,
+    # so Sigma is diagonal: sum_j S_rj^2 sigma_j^2.
+    sigma_rows = np.einsum("bmj,bj->bm", S * S, noise_var)
+    meat = np.einsum("bmi,bm,bmj->bij", J, sigma_rows, J)
+    Hinv = np.linalg.inv(H)
+    return Hinv @ meat @ Hinv
+
+
+def initial_guess(obs: ObservationSet) -> np.ndarray:
+    """Per-axis linear start (B, 6), ignoring misalignment.
+
+    For windows turning mainly about axis j, ``m_j = s omega / k_j - b_j``; static windows
+    give ``m_j = -b_j``. Each axis is then a two-unknown linear fit in ``(1/k_j, b_j)``.
+    """
+    B = obs.mean.shape[0]
+    p0 = np.empty((B, 6))
+    dominant = np.abs(obs.mean).argmax(axis=-1)
+    for j in range(3):
+        on_axis = (dominant == j) & ~obs.static  # (B, n)
+        if not on_axis[0].any():
+            raise DegenerateDesignError(
+                f"no rotation about the {'xyz'[j]} axis; k{'xyz'[j]} cannot be observed. Turn about every axis"
+            )
+        use = on_axis | obs.static
+        x = np.where(on_axis, np.sign(obs.mean[..., j]) * obs.rate, 0.0)  # signed reference
+        w = use * obs.count
+        A = np.stack([x, -np.ones_like(x)], axis=-1) * np.sqrt(w)[..., None]
+        y = obs.mean[..., j] * np.sqrt(w)
+        AtA = np.einsum("bni,bnj->bij", A, A)
+        if np.linalg.matrix_rank(AtA[0]) < 2:
+            raise DegenerateDesignError(
+                f"the {'xyz'[j]} axis has one rotation and no static window, so its bias and scale "
+                "cannot be separated; turn both ways or add a static window"
+            )
+        c, neg_b = np.linalg.solve(AtA, np.einsum("bni,bn->bi", A, y)[..., None])[..., 0].T
+        p0[:, j], p0[:, 3 + j] = 1.0 / c, neg_b
+    return p0
+
+
+def first_moment_batch(
+    obs: ObservationSet,
+    *,
+    noise_var=None,
+    max_iter: int = 100,
+) -> BatchFit:
+    """Fit ``(k, b)`` from first-moment equations for every gyro of a batch.
+
+    Parameters
+    ----------
+    obs : ObservationSet
+        Rotation windows (speed or angle reference) and static windows.
+    noise_var : array_like, shape (3,) or (B, 3), optional
+        Known per-sample noise variance [reading units^2]; estimated from the data when
+        omitted (:func:`estimate_noise_var`).
+    max_iter : int
+        Most Levenberg–Marquardt iterations.
+    """
+    obs = obs.as_batch()
+    n_rot = int((~obs.static).sum())
+    require_count(n_rot + 3 * int(obs.static.sum()), f"{n_rot} rotation and {int(obs.static.sum())} static window(s)")
+    p0 = initial_guess(obs)
+    fun = lambda p: residuals_and_jacobian(p, obs)[:2]  # noqa: E731
+    p, iterations, converged, residuals, history = batched_lm(fun, p0, max_iter=max_iter)
+    require_converged(converged, iterations, "first-moment least squares")
+    # The norm equations cannot see the sign of k; a positive scale is the physical one.
+    p[:, :3] = np.abs(p[:, :3])
+    history[..., :3] = np.abs(history[..., :3])
+    require_positive_k2(p[:, :3] ** 2, "first-moment least squares")
+    _, J, S = residuals_and_jacobian(p, obs)
+    require_full_rank(J[0], PARAM_NAMES, "the windows")
+    if noise_var is None:
+        nv = estimate_noise_var(obs)
+    else:
+        nv = np.broadcast_to(np.asarray(noise_var, dtype=float), (len(p), 3))
+        if not np.all(np.isfinite(nv)) or np.any(nv < 0):
+            raise InputError(f"noise_var must be finite and >= 0, got {noise_var!r}")
+    return BatchFit(
+        method="first-moment", k=p[:, :3], b=p[:, 3:], iterations=iterations, converged=converged,
+        residuals=residuals, covariance=sandwich_covariance(J, S, nv), noise_std=np.sqrt(nv), history=history,
+    )
+
+
+@dataclass(frozen=True)
+class FirstMoment:
+    """The first-moment estimator: unbiased scale and bias with a covariance.
+
+    Parameters
+    ----------
+    noise_std : float or array_like of shape (3,), optional
+        Known per-sample white-noise standard deviation [reading units], for example
+        from ``gyrocal noise``. Estimated from the windows when omitted.
+    max_iter : int
+        Most Levenberg–Marquardt iterations.
+    """
+
+    noise_std: float | tuple[float, float, float] | None = None
+    max_iter: int = 100
+
+    def _noise_var(self):
+        return None if self.noise_std is None else np.broadcast_to(np.square(np.asarray(self.noise_std, float)), (3,))
+
+    def fit(self, obs: ObservationSet) -> FitResult:
+        """Estimate one gyro's scale factors and biases, with their covariance."""
+        return self.fit_batch(obs.as_batch()).item(0)
+
+    def fit_batch(self, obs: ObservationSet) -> BatchFit:
+        """Estimate every gyro of a batch."""
+        return first_moment_batch(obs, noise_var=self._noise_var(), max_iter=self.max_iter)

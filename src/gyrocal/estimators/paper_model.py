@@ -1,0 +1,43 @@
+"""Seed 000's linear regression form, shared by Algorithm 1 and its LM comparison.
+
+Eq. 4: ``y = beta0 + sum_j beta_j x_j`` with regressors ``x = (mean m^2, mean m)``
+per window (eq. 8), response ``y = omega^2``, and ``beta0 = sum beta_{j+3}^2 / (4 beta_j)``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..observations import ObservationSet
+from ._checks import require_count, require_full_rank, require_positive_k2
+
+BETA_NAMES = ("beta1", "beta2", "beta3", "beta4", "beta5", "beta6")
+
+
+def regressors(obs: ObservationSet) -> tuple[np.ndarray, np.ndarray]:
+    """Eq. 7 and 8: X (B, n, 6) ``[m_x^2, m_y^2, m_z^2, m_x, m_y, m_z]`` (window means) and Y (B, n)."""
+    obs = obs.as_batch()
+    require_count(len(obs), f"{len(obs)} observation(s)")
+    X = np.concatenate([obs.mean_sq, obs.mean], axis=-1)
+    require_full_rank(X[0], BETA_NAMES, "the observations")
+    return X, obs.rate**2
+
+
+def gamma(beta: np.ndarray) -> np.ndarray:
+    """``beta0`` implied by ``beta`` (B, 6): ``sum beta_{j+3}^2 / (4 beta_j)``."""
+    return np.sum(beta[:, 3:] ** 2 / (4.0 * beta[:, :3]), axis=1)
+
+
+def beta_to_kb(beta: np.ndarray, method: str) -> tuple[np.ndarray, np.ndarray]:
+    """Algorithm 1's return step: ``k = sqrt(beta_1..3)``, ``b = beta_4..6 / (2 beta_1..3)``."""
+    require_positive_k2(beta[..., :3], method)
+    return np.sqrt(beta[..., :3]), beta[..., 3:] / (2.0 * beta[..., :3])
+
+
+def kb_history(beta_history: np.ndarray) -> np.ndarray:
+    """(k, b) rows from beta rows, leaving non-physical rows as NaN."""
+    b1 = beta_history[..., :3]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        k = np.where(b1 > 0, np.sqrt(np.abs(b1)), np.nan)
+        b = beta_history[..., 3:] / (2.0 * b1)
+    return np.concatenate([k, b], axis=-1)

@@ -1,0 +1,203 @@
+"""Calibration models and their one canonical correction.
+
+Both papers' models are affine maps from a reading ``m`` to the true rate; gyrocal
+stores each in the canonical form
+
+    w_true = A (m - o)
+
+and keeps each paper's own parameters, converting exactly in both directions:
+
+* :class:`ScaleBias` (seed 000, eq. 1): ``g = diag(k) (m + b)``, so ``A = diag(k)``, ``o = -b``.
+* :class:`Affine` (seed 001, eq. 12): ``w = K w~ + B``, so ``A = K^-1``, ``o = B``.
+
+Models are unit-agnostic numbers: ``o`` is in the units of the readings and ``A``
+maps reading units to output units. The package keeps both in rad/s inside; files
+record units explicitly (see :mod:`gyrocal.calibration`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import ClassVar, Union
+
+import numpy as np
+
+from ._validation import finite_array, vector3
+from .errors import InputError, NonPhysicalEstimateError
+
+__all__ = ["ScaleBias", "Affine", "CalibrationModel", "correct", "KG_NAMES", "KG_INDEX"]
+
+#: Seed 001 eq. 14: element order of the 12-vector Kg.
+KG_NAMES: tuple[str, ...] = ("Kxx", "Kyy", "Kzz", "Kyx", "Kzx", "Kxy", "Kzy", "Kxz", "Kyz", "Bx", "By", "Bz")
+#: Position in K (eq. 11) of each of the first nine Kg elements.
+#: K = [[Kxx, Kyx, Kzx], [Kxy, Kyy, Kzy], [Kxz, Kyz, Kzz]], so row = output axis, column = input axis.
+KG_INDEX: tuple[tuple[int, int], ...] = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1))
+_KG_ROWS = np.array([r for r, _ in KG_INDEX])
+_KG_COLS = np.array([c for _, c in KG_INDEX])
+
+
+def correct(matrix: np.ndarray, offset: np.ndarray, readings) -> np.ndarray:
+    """Apply ``w_true = matrix @ (m - offset)`` to readings of shape (..., 3) [reading units]."""
+    m = finite_array("readings", readings, shape_tail=(3,))
+    return (m - offset) @ np.asarray(matrix).T
+
+
+def _freeze(arr: np.ndarray) -> np.ndarray:
+    arr = np.array(arr, dtype=float)
+    arr.setflags(write=False)
+    return arr
+
+
+@dataclass(frozen=True)
+class ScaleBias:
+    """Per-axis scale and bias, seed 000 eq. 1: ``g = diag(k) (m + b)``.
+
+    Parameters
+    ----------
+    k : array_like, shape (3,)
+        Scale factors [output units per reading unit], all > 0.
+    b : array_like, shape (3,)
+        Additive biases [reading units]. Note the sign: ``b`` is added to the
+        reading, so it is minus the usual zero-rate offset.
+    """
+
+    k: np.ndarray
+    b: np.ndarray
+    kind: ClassVar[str] = "scale-bias"
+    param_names: ClassVar[tuple[str, ...]] = ("kx", "ky", "kz", "bx", "by", "bz")
+
+    def __post_init__(self):
+        k = vector3("k", self.k)
+        if np.any(k <= 0):
+            raise NonPhysicalEstimateError(f"scale factors k must be > 0, got {k.tolist()}")
+        object.__setattr__(self, "k", _freeze(k))
+        object.__setattr__(self, "b", _freeze(vector3("b", self.b)))
+
+    @property
+    def matrix(self) -> np.ndarray:
+        """Canonical ``A = diag(k)``."""
+        return np.diag(self.k)
+
+    @property
+    def offset(self) -> np.ndarray:
+        """Canonical ``o = -b`` [reading units]."""
+        return -self.b
+
+    @property
+    def params(self) -> np.ndarray:
+        """Parameter vector in :attr:`param_names` order."""
+        return np.concatenate([self.k, self.b])
+
+    @classmethod
+    def from_params(cls, params) -> "ScaleBias":
+        p = finite_array("params", params, shape_tail=(6,), ndim=1)
+        return cls(k=p[:3], b=p[3:])
+
+    @classmethod
+    def from_canonical(cls, matrix, offset) -> "ScaleBias":
+        """Exact inverse of (:attr:`matrix`, :attr:`offset`); `matrix` must be diagonal."""
+        a = finite_array("matrix", matrix, shape_tail=(3, 3), ndim=2)
+        if np.any(a[~np.eye(3, dtype=bool)] != 0):
+            raise InputError("matrix has off-diagonal terms; a scale-bias model needs a diagonal matrix (use Affine)")
+        return cls(k=np.diag(a).copy(), b=-vector3("offset", offset))
+
+    def correct(self, readings) -> np.ndarray:
+        """True rates from readings of shape (..., 3): ``diag(k) (m + b)``."""
+        return correct(self.matrix, self.offset, readings)
+
+    def distort(self, true_rates) -> np.ndarray:
+        """Readings a gyro with this model would give for `true_rates` (noise-free inverse)."""
+        w = finite_array("true_rates", true_rates, shape_tail=(3,))
+        return w / self.k - self.b
+
+    def to_affine(self) -> "Affine":
+        """The same map as an :class:`Affine` model (``K = diag(1/k)``, ``B = -b``)."""
+        return Affine.from_canonical(self.matrix, self.offset)
+
+    def to_dict(self) -> dict:
+        """Seed 000 parameters, as plain lists."""
+        return {"k": self.k.tolist(), "b": self.b.tolist()}
+
+
+@dataclass(frozen=True)
+class Affine:
+    """Full 12-parameter model, seed 001 eq. 12: ``w = K w~ + B``.
+
+    Parameters
+    ----------
+    K : array_like, shape (3, 3)
+        Scale, package misalignment and non-orthogonality [reading units per output unit];
+        eq. 11 layout, row = gyro axis, column = reference axis. Must be invertible.
+    B : array_like, shape (3,)
+        Bias [reading units].
+    """
+
+    K: np.ndarray
+    B: np.ndarray
+    kind: ClassVar[str] = "affine"
+    param_names: ClassVar[tuple[str, ...]] = KG_NAMES
+
+    def __post_init__(self):
+        K = finite_array("K", self.K, shape_tail=(3, 3), ndim=2)
+        cond = np.linalg.cond(K)
+        if not np.isfinite(cond) or cond > 1e12:
+            raise NonPhysicalEstimateError(f"K is singular (condition number {cond:.3g}); it cannot be inverted")
+        object.__setattr__(self, "K", _freeze(K))
+        object.__setattr__(self, "B", _freeze(vector3("B", self.B)))
+
+    @property
+    def matrix(self) -> np.ndarray:
+        """Canonical ``A = K^-1``."""
+        return np.linalg.inv(self.K)
+
+    @property
+    def offset(self) -> np.ndarray:
+        """Canonical ``o = B`` [reading units]."""
+        return np.array(self.B)
+
+    @property
+    def kg(self) -> np.ndarray:
+        """Seed 001 eq. 14 12-vector ``[Kxx, Kyy, Kzz, Kyx, Kzx, Kxy, Kzy, Kxz, Kyz, Bx, By, Bz]``."""
+        return np.concatenate([self.K[_KG_ROWS, _KG_COLS], self.B])
+
+    @property
+    def params(self) -> np.ndarray:
+        """Parameter vector in :attr:`param_names` (Kg) order."""
+        return self.kg
+
+    @classmethod
+    def from_kg(cls, kg) -> "Affine":
+        """Build from the seed 001 12-vector (eq. 14 order)."""
+        v = finite_array("kg", kg, shape_tail=(12,), ndim=1)
+        K = np.zeros((3, 3))
+        K[_KG_ROWS, _KG_COLS] = v[:9]
+        return cls(K=K, B=v[9:])
+
+    from_params = from_kg
+
+    @classmethod
+    def from_canonical(cls, matrix, offset) -> "Affine":
+        """Exact inverse of (:attr:`matrix`, :attr:`offset`)."""
+        a = finite_array("matrix", matrix, shape_tail=(3, 3), ndim=2)
+        if np.linalg.cond(a) > 1e12:
+            raise NonPhysicalEstimateError("correction matrix is singular; it cannot describe a gyro")
+        return cls(K=np.linalg.inv(a), B=vector3("offset", offset))
+
+    def correct(self, readings) -> np.ndarray:
+        """True rates from readings of shape (..., 3): ``K^-1 (w - B)``."""
+        return correct(self.matrix, self.offset, readings)
+
+    def distort(self, true_rates) -> np.ndarray:
+        """Readings for `true_rates` (noise-free): ``K w~ + B``."""
+        w = finite_array("true_rates", true_rates, shape_tail=(3,))
+        return w @ self.K.T + self.B
+
+    def to_affine(self) -> "Affine":
+        return self
+
+    def to_dict(self) -> dict:
+        """Seed 001 parameters: Kg in eq. 14 order, with names."""
+        return {"kg": self.kg.tolist(), "kg_names": list(KG_NAMES)}
+
+
+CalibrationModel = Union[ScaleBias, Affine]

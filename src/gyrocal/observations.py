@@ -1,0 +1,214 @@
+"""Window reductions: what the estimators see of a recording.
+
+A window of raw samples is reduced to its mean, its mean of squares, a white-noise
+variance, its sample count and its duration, together with its reference:
+
+* ``speed``: a known constant rate magnitude during the window;
+* ``angle``: a known angle turned inside the window, giving ``rate = angle / duration``;
+* ``static``: no rotation (rate zero).
+
+:class:`ObservationSet` stacks windows into arrays, optionally with a leading batch
+axis (many gyros measured with one design), which is what the estimators consume.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal, Sequence
+
+import numpy as np
+
+from ._validation import finite_array, positive
+from .errors import InputError
+
+__all__ = ["ReferenceKind", "Observation", "ObservationSet", "observe"]
+
+ReferenceKind = Literal["speed", "angle", "static"]
+_KINDS = ("speed", "angle", "static")
+
+
+@dataclass(frozen=True)
+class Observation:
+    """One window's reductions and reference.
+
+    Attributes
+    ----------
+    mean : ndarray, shape (3,)
+        Window mean of the readings [reading units].
+    mean_sq : ndarray, shape (3,)
+        Window mean of the squared readings [reading units^2] (seed 000 eq. 8 regressors).
+    noise_var : ndarray, shape (3,)
+        Per-sample white-noise variance, from first differences [reading units^2].
+        Differencing removes the rotation itself, ramps and slow vibration.
+    count : int
+        Number of samples.
+    duration : float
+        Window length [s], ``count / sample_rate``.
+    kind : {"speed", "angle", "static"}
+        Reference type.
+    rate : float
+        Reference mean rate magnitude [rad/s]; 0 for static windows.
+    angle : float
+        Angle turned inside the window [rad]; NaN unless ``kind == "angle"``.
+    """
+
+    mean: np.ndarray
+    mean_sq: np.ndarray
+    noise_var: np.ndarray
+    count: int
+    duration: float
+    kind: ReferenceKind
+    rate: float
+    angle: float = math.nan
+
+    def __post_init__(self):
+        for name in ("mean", "mean_sq", "noise_var"):
+            arr = finite_array(name, getattr(self, name), shape_tail=(3,), ndim=1)
+            arr.setflags(write=False)
+            object.__setattr__(self, name, arr)
+        if self.kind not in _KINDS:
+            raise InputError(f"kind={self.kind!r} is not one of {_KINDS}")
+        if int(self.count) < 2:
+            raise InputError(f"a window needs at least 2 samples, got count={self.count}")
+        positive("duration", self.duration)
+        if self.kind == "static" and self.rate != 0:
+            raise InputError(f"a static window has rate 0, got {self.rate}")
+        if self.kind != "static":
+            positive("rate", self.rate)
+
+
+def _magnitude(name: str, value) -> float:
+    """|value|, refusing zero and non-numbers: a turn's sense does not matter to the norm equations."""
+    try:
+        return positive(name, abs(float(value)))
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a non-zero number, got {value!r}") from None
+
+
+def observe(
+    samples,
+    sample_rate: float,
+    kind: ReferenceKind,
+    *,
+    speed: float | None = None,
+    angle: float | None = None,
+) -> Observation:
+    """Reduce a window of readings to an :class:`Observation`.
+
+    Parameters
+    ----------
+    samples : array_like, shape (n, 3)
+        Readings inside the window [reading units].
+    sample_rate : float
+        Sampling rate [Hz].
+    kind : {"speed", "angle", "static"}
+        Reference type.
+    speed : float, optional
+        Known rate magnitude [rad/s]; required for ``kind="speed"``.
+    angle : float, optional
+        Angle turned inside the window [rad]; required for ``kind="angle"``.
+    """
+    m = finite_array("samples", samples, shape_tail=(3,), ndim=2)
+    fs = positive("sample_rate", sample_rate)
+    if len(m) < 2:
+        raise InputError(f"a window needs at least 2 samples, got {len(m)}")
+    duration = len(m) / fs
+    if kind == "speed":
+        if speed is None:
+            raise InputError("kind='speed' needs speed [rad/s]")
+        rate, ang = _magnitude("speed", speed), math.nan
+    elif kind == "angle":
+        if angle is None:
+            raise InputError("kind='angle' needs angle [rad]")
+        ang = _magnitude("angle", angle)
+        rate = ang / duration
+    elif kind == "static":
+        rate, ang = 0.0, math.nan
+    else:
+        raise InputError(f"kind={kind!r} is not one of {_KINDS}")
+    d = np.diff(m, axis=0)
+    return Observation(
+        mean=m.mean(axis=0),
+        mean_sq=(m * m).mean(axis=0),
+        noise_var=(d * d).mean(axis=0) / 2.0,
+        count=len(m),
+        duration=duration,
+        kind=kind,
+        rate=rate,
+        angle=ang,
+    )
+
+
+@dataclass(frozen=True)
+class ObservationSet:
+    """Windows stacked into arrays, optionally for a batch of gyros.
+
+    Shapes use ``n`` for windows and an optional leading batch axis ``B``:
+    ``mean``, ``mean_sq``, ``noise_var`` are (n, 3) or (B, n, 3); ``rate`` is (n,)
+    or (B, n); ``count``, ``duration`` and ``static`` are (n,) and shared by the batch
+    (one design). Reference rates are in rad/s.
+    """
+
+    mean: np.ndarray
+    mean_sq: np.ndarray
+    noise_var: np.ndarray
+    rate: np.ndarray
+    count: np.ndarray
+    duration: np.ndarray
+    static: np.ndarray
+
+    def __post_init__(self):
+        mean = finite_array("mean", self.mean, shape_tail=(3,))
+        if mean.ndim not in (2, 3):
+            raise InputError(f"mean must have shape (n, 3) or (B, n, 3), got {mean.shape}")
+        n = mean.shape[-2]
+        for name in ("mean_sq", "noise_var"):
+            arr = finite_array(name, getattr(self, name))
+            if arr.shape != mean.shape:
+                raise InputError(f"{name} must have the shape of mean {mean.shape}, got {arr.shape}")
+            object.__setattr__(self, name, arr)
+        rate = finite_array("rate", self.rate)
+        if rate.shape not in ((n,), mean.shape[:-1]):
+            raise InputError(f"rate must have shape ({n},) or {mean.shape[:-1]}, got {rate.shape}")
+        for name in ("count", "duration"):
+            arr = finite_array(name, getattr(self, name), ndim=1)
+            if arr.shape != (n,) or np.any(arr <= 0):
+                raise InputError(f"{name} must be {n} positive values, got shape {arr.shape}")
+            object.__setattr__(self, name, arr)
+        static = np.asarray(self.static, dtype=bool)
+        if static.shape != (n,):
+            raise InputError(f"static must be {n} flags, got shape {static.shape}")
+        object.__setattr__(self, "mean", mean)
+        object.__setattr__(self, "rate", np.broadcast_to(rate, mean.shape[:-1]) if rate.ndim == 1 else rate)
+        object.__setattr__(self, "static", static)
+
+    @classmethod
+    def from_observations(cls, observations: Sequence[Observation]) -> "ObservationSet":
+        """Stack single-gyro observations."""
+        obs = list(observations)
+        if not obs:
+            raise InputError("no observations given; a calibration needs at least six")
+        return cls(
+            mean=np.stack([o.mean for o in obs]),
+            mean_sq=np.stack([o.mean_sq for o in obs]),
+            noise_var=np.stack([o.noise_var for o in obs]),
+            rate=np.array([o.rate for o in obs]),
+            count=np.array([o.count for o in obs], dtype=float),
+            duration=np.array([o.duration for o in obs]),
+            static=np.array([o.kind == "static" for o in obs]),
+        )
+
+    @property
+    def batched(self) -> bool:
+        return self.mean.ndim == 3
+
+    def as_batch(self) -> "ObservationSet":
+        """This set with a leading batch axis (of length 1 if it had none)."""
+        if self.batched:
+            return self
+        return ObservationSet(self.mean[None], self.mean_sq[None], self.noise_var[None], self.rate[None],
+                              self.count, self.duration, self.static)
+
+    def __len__(self) -> int:
+        return self.mean.shape[-2]
