@@ -1,0 +1,64 @@
+"""The ``gyrocal`` Typer application and its error boundary.
+
+Command modules register on :data:`app`. Library errors become one line on stderr
+and exit code 2; ``--debug`` shows the traceback instead.
+"""
+
+from __future__ import annotations
+
+import sys
+
+try:
+    import typer
+    from rich.console import Console
+except ImportError:  # pragma: no cover - exercised only without the extra
+    sys.stderr.write("gyrocal: the command line needs its extra: pip install 'gyrocal[cli]'\n")
+    raise SystemExit(2)
+
+from ..errors import GyrocalError
+
+app = typer.Typer(
+    name="gyrocal",
+    help="Calibrate triaxial MEMS gyroscopes: servo-aided and full-temperature-range methods.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+console = Console()
+err_console = Console(stderr=True)
+_state = {"debug": False}
+
+
+@app.callback()
+def _root(debug: bool = typer.Option(False, "--debug", help="Show tracebacks instead of one-line errors.")) -> None:
+    _state["debug"] = debug
+
+
+def fail(message: str) -> "typer.Exit":
+    """Print one line to stderr and return the exit to raise (code 2)."""
+    err_console.print(f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True)
+    return typer.Exit(code=2)
+
+
+def run(argv: list[str] | None = None) -> int:
+    """Run the CLI; map library and OS errors to exit code 2 with one line."""
+    try:
+        app(args=argv, standalone_mode=False)
+    except (GyrocalError, OSError) as exc:
+        if _state["debug"]:
+            raise
+        fail(str(exc) if isinstance(exc, GyrocalError) else f"{exc.strerror or exc}: {exc.filename or ''}".strip(": "))
+        return 2
+    except typer.Exit as exc:
+        return exc.exit_code
+    except typer.Abort:
+        err_console.print("aborted")
+        return 1
+    except Exception as exc:  # click usage errors
+        import click
+
+        if isinstance(exc, click.ClickException):
+            exc.show()
+            return 2
+        raise
+    return 0

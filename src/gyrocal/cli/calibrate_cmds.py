@@ -1,0 +1,3 @@
+"""Commands registered on the gyrocal app (placeholder until filled in)."""
+
+from .app import app  # noqa: F401
