@@ -33,11 +33,11 @@ import numpy as np
 
 from . import __version__
 from ._jsonfile import check_header, get, get_array, read_json, write_json
-from .errors import FileFormatError, InputError, UnitError
-from .models import KG_NAMES, Affine, CalibrationModel, ScaleBias
+from .errors import FileFormatError, InputError, NonPhysicalEstimateError, UnitError
+from .models import Affine, CalibrationModel, ScaleBias
 from .units import InputUnit, RateUnit, parse_input_unit, parse_rate_unit, unit_factor
 
-__all__ = ["Calibration", "save_calibration", "load_calibration", "FORMAT", "VERSION"]
+__all__ = ["FORMAT", "VERSION", "Calibration", "load_calibration", "save_calibration"]
 
 FORMAT = "gyrocal.calibration"
 VERSION = 1
@@ -160,6 +160,8 @@ def to_document(cal: Calibration) -> dict[str, Any]:
 
 def from_document(doc: dict, path="file") -> Calibration:
     """Validate a document and rebuild the :class:`Calibration`, naming any bad field."""
+    if not isinstance(doc, dict):
+        raise FileFormatError(f"{path}: expected a JSON object at the top level, got {type(doc).__name__}")
     check_header(doc, path, FORMAT, (VERSION,))
     kind = get(doc, "model", path)
     try:
@@ -171,7 +173,7 @@ def from_document(doc: dict, path="file") -> Calibration:
             model = Affine.from_kg(get_array(doc, "parameters.seed001.kg", (12,), path))
         else:
             raise FileFormatError(f"{path}: field 'model' is {kind!r}; expected 'scale-bias' or 'affine'", "model")
-    except (InputError, ValueError) as exc:
+    except (InputError, NonPhysicalEstimateError, ValueError) as exc:
         if isinstance(exc, FileFormatError):
             raise
         raise FileFormatError(f"{path}: field 'parameters' does not describe a gyro: {exc}", "parameters") from None

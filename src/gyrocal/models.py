@@ -17,15 +17,15 @@ record units explicitly (see :mod:`gyrocal.calibration`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import ClassVar, Union
+from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
 from ._validation import finite_array, vector3
 from .errors import InputError, NonPhysicalEstimateError
 
-__all__ = ["ScaleBias", "Affine", "CalibrationModel", "correct", "KG_NAMES", "KG_INDEX"]
+__all__ = ["KG_INDEX", "KG_NAMES", "Affine", "CalibrationModel", "ScaleBias", "correct"]
 
 #: Seed 001 eq. 14: element order of the 12-vector Kg.
 KG_NAMES: tuple[str, ...] = ("Kxx", "Kyy", "Kzz", "Kyx", "Kzx", "Kxy", "Kzy", "Kxz", "Kyz", "Bx", "By", "Bz")
@@ -89,12 +89,12 @@ class ScaleBias:
         return np.concatenate([self.k, self.b])
 
     @classmethod
-    def from_params(cls, params) -> "ScaleBias":
+    def from_params(cls, params) -> ScaleBias:
         p = finite_array("params", params, shape_tail=(6,), ndim=1)
         return cls(k=p[:3], b=p[3:])
 
     @classmethod
-    def from_canonical(cls, matrix, offset) -> "ScaleBias":
+    def from_canonical(cls, matrix, offset) -> ScaleBias:
         """Exact inverse of (:attr:`matrix`, :attr:`offset`); `matrix` must be diagonal."""
         a = finite_array("matrix", matrix, shape_tail=(3, 3), ndim=2)
         if np.any(a[~np.eye(3, dtype=bool)] != 0):
@@ -110,7 +110,7 @@ class ScaleBias:
         w = finite_array("true_rates", true_rates, shape_tail=(3,))
         return w / self.k - self.b
 
-    def to_affine(self) -> "Affine":
+    def to_affine(self) -> Affine:
         """The same map as an :class:`Affine` model (``K = diag(1/k)``, ``B = -b``)."""
         return Affine.from_canonical(self.matrix, self.offset)
 
@@ -166,7 +166,7 @@ class Affine:
         return self.kg
 
     @classmethod
-    def from_kg(cls, kg) -> "Affine":
+    def from_kg(cls, kg) -> Affine:
         """Build from the seed 001 12-vector (eq. 14 order)."""
         v = finite_array("kg", kg, shape_tail=(12,), ndim=1)
         K = np.zeros((3, 3))
@@ -176,7 +176,7 @@ class Affine:
     from_params = from_kg
 
     @classmethod
-    def from_canonical(cls, matrix, offset) -> "Affine":
+    def from_canonical(cls, matrix, offset) -> Affine:
         """Exact inverse of (:attr:`matrix`, :attr:`offset`)."""
         a = finite_array("matrix", matrix, shape_tail=(3, 3), ndim=2)
         if np.linalg.cond(a) > 1e12:
@@ -192,7 +192,7 @@ class Affine:
         w = finite_array("true_rates", true_rates, shape_tail=(3,))
         return w @ self.K.T + self.B
 
-    def to_affine(self) -> "Affine":
+    def to_affine(self) -> Affine:
         return self
 
     def to_dict(self) -> dict:
@@ -200,4 +200,4 @@ class Affine:
         return {"kg": self.kg.tolist(), "kg_names": list(KG_NAMES)}
 
 
-CalibrationModel = Union[ScaleBias, Affine]
+CalibrationModel = ScaleBias | Affine

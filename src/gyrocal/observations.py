@@ -14,15 +14,16 @@ axis (many gyros measured with one design), which is what the estimators consume
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Literal, Sequence
+from typing import Literal
 
 import numpy as np
 
 from ._validation import finite_array, positive
 from .errors import InputError
 
-__all__ = ["ReferenceKind", "Observation", "ObservationSet", "observe"]
+__all__ = ["Observation", "ObservationSet", "ReferenceKind", "observe"]
 
 ReferenceKind = Literal["speed", "angle", "static"]
 _KINDS = ("speed", "angle", "static")
@@ -184,7 +185,7 @@ class ObservationSet:
         object.__setattr__(self, "static", static)
 
     @classmethod
-    def from_observations(cls, observations: Sequence[Observation]) -> "ObservationSet":
+    def from_observations(cls, observations: Sequence[Observation]) -> ObservationSet:
         """Stack single-gyro observations."""
         obs = list(observations)
         if not obs:
@@ -203,12 +204,24 @@ class ObservationSet:
     def batched(self) -> bool:
         return self.mean.ndim == 3
 
-    def as_batch(self) -> "ObservationSet":
+    def as_batch(self) -> ObservationSet:
         """This set with a leading batch axis (of length 1 if it had none)."""
         if self.batched:
             return self
         return ObservationSet(self.mean[None], self.mean_sq[None], self.noise_var[None], self.rate[None],
                               self.count, self.duration, self.static)
+
+    def take(self, index) -> ObservationSet:
+        """The gyros at `index` (a slice, an int array or a boolean mask), still batched."""
+        b = self.as_batch()
+        idx = index if isinstance(index, slice) else np.asarray(index)
+        return ObservationSet(b.mean[idx], b.mean_sq[idx], b.noise_var[idx], b.rate[idx],
+                              self.count, self.duration, self.static)
+
+    @property
+    def batch_size(self) -> int:
+        """Number of gyros (1 for an unbatched set)."""
+        return self.mean.shape[0] if self.batched else 1
 
     def __len__(self) -> int:
         return self.mean.shape[-2]

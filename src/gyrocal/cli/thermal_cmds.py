@@ -1,3 +1,173 @@
-"""Commands registered on the gyrocal app (placeholder until filled in)."""
+"""Commands ``thermal`` and ``thermal-report``: seed 001 from the command line.
 
-from .app import app  # noqa: F401
+User units live here: ``--full-scale`` is in the data's unit; temperatures in degC.
+Library warnings (saturated steps, clamped temperatures) are printed as one line each.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import warnings
+from enum import Enum
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+
+from ..units import parse_input_unit, parse_rate_unit, unit_factor
+from .app import app, console, err_console, fail
+
+__all__ = ["thermal", "thermal_report"]
+
+
+class OutOfRangePolicy(str, Enum):
+    refuse = "refuse"
+    clamp = "clamp"
+    extrapolate = "extrapolate"
+
+
+Units = Annotated[str, typer.Option("--units", help="Unit of the gyro and table_rate columns: rad/s, deg/s or counts.")]
+Columns = Annotated[str | None, typer.Option(
+    "--columns", help="Map gyrocal names to the file's, e.g. gx=GX,temp=T,table_rate=RATE,axis=POS.")]
+SampleRate = Annotated[float | None, typer.Option("--sample-rate", help="Sample rate (Hz) when there is no t column.")]
+Sensitivity = Annotated[float | None, typer.Option("--sensitivity", help="For --units counts: LSB per --output-units.")]
+OutputUnits = Annotated[str | None, typer.Option("--output-units", help="Unit of corrected rates (default --units).")]
+Settle = Annotated[float, typer.Option("--settle", help="Time dropped at the start of every step (s).")]
+FullScale = Annotated[float | None, typer.Option(
+    "--full-scale", help="Gyro range in the data's unit; steps with samples at it are left out (with a warning).")]
+TempTol = Annotated[float, typer.Option(
+    "--temp-tolerance", help="Spread allowed inside a step, and closest distinct temperature points (degC).")]
+
+
+@contextlib.contextmanager
+def _print_warnings():
+    """Show library warnings as one line each on stderr."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        yield
+    for w in caught:
+        err_console.print(f"[yellow]warning:[/] {w.message}", highlight=False, soft_wrap=True)
+
+
+def _units(units: str, output_units: str | None, sensitivity: float | None) -> tuple[str, str]:
+    """(input unit of the table, output unit) for the command's flags."""
+    u = parse_input_unit(units, "--units")
+    if u == "counts":
+        if sensitivity is None or output_units is None:
+            raise fail("--units counts needs --sensitivity and --output-units (the physical unit of the counts)")
+        return parse_rate_unit(output_units, "--output-units"), parse_rate_unit(output_units, "--output-units")
+    return u, parse_rate_unit(output_units or u, "--output-units")
+
+
+def _full_scale(value: float | None, units: str, rate_unit: str, sensitivity: float | None) -> float | None:
+    """--full-scale in rad/s."""
+    if value is None:
+        return None
+    if parse_input_unit(units) == "counts":
+        return value / sensitivity * unit_factor(rate_unit)
+    return value * unit_factor(units)
+
+
+def _read(path: Path, units: str, columns, sample_rate, sensitivity, output_units):
+    from ..thermal import read_session
+
+    return read_session(path, units=units, columns=columns, sample_rate=sample_rate, sensitivity=sensitivity,
+                        output_units=output_units, saturation="ignore")
+
+
+@app.command("thermal")
+def thermal(
+    session: Annotated[Path, typer.Argument(help="Session: one CSV/Parquet/bag with every temperature point, or a folder.")],
+    units: Units,
+    output: Annotated[Path, typer.Option("-o", "--output", help="Thermal calibration file to write (JSON).")],
+    output_units: OutputUnits = None,
+    columns: Columns = None,
+    sample_rate: SampleRate = None,
+    sensitivity: Sensitivity = None,
+    settle: Settle = 2.0,
+    full_scale: FullScale = None,
+    temp_tolerance: TempTol = 2.0,
+    ref_temp: Annotated[float, typer.Option("--ref-temp", help="Temperature of the traditional baseline (degC).")] = 25.0,
+    max_order: Annotated[int, typer.Option("--max-order", help="Highest polynomial order of the smooth model.")] = 3,
+    temp_tau: Annotated[float, typer.Option(
+        "--temp-tau", help="Time constant for smoothing per-sample temperature when compensating (s).")] = 20.0,
+) -> None:
+    """Fit a temperature table (seed 001) from a turntable session."""
+    from ..thermal import calibrate_thermal, save_thermal
+
+    in_u, out_u = _units(units, output_units, sensitivity)
+    with _print_warnings():
+        recs, names = _read(session, units, columns, sample_rate, sensitivity, output_units)
+        cal, fit = calibrate_thermal(recs, input_units=in_u, output_units=out_u, settle=settle,
+                                     full_scale=_full_scale(full_scale, units, out_u, sensitivity),
+                                     temp_tolerance=temp_tolerance, reference_temp=ref_temp, max_order=max_order,
+                                     temp_tau=temp_tau, names=names)
+    save_thermal(cal, output)
+    _print_table(cal, fit)
+    console.print(f"wrote {output}")
+
+
+def _print_table(cal, fit) -> None:
+    from rich.box import SIMPLE
+    from rich.markup import escape
+    from rich.table import Table
+
+    user = cal.kg_user
+    table = Table(title=escape(f"Kg per temperature (B and residual RMS in [{cal.input_units}])"), box=SIMPLE, padding=(0, 1), pad_edge=False)
+    for col in ("T degC", "Kxx", "Kyy", "Kzz", "Bx", "By", "Bz", "resid"):
+        table.add_column(escape(col), justify="right", no_wrap=True, min_width=7)
+    for i, t in enumerate(cal.temps):
+        k = user[i]
+        table.add_row(f"{t:.1f}", *(f"{k[j]:.5f}" for j in (0, 1, 2)),
+                      *(f"{k[j]:.4f}" for j in (9, 10, 11)),
+                      f"{np.max(cal.residual_rms[i]) / unit_factor(cal.input_units):.2g}")
+    console.print(table)
+    console.print(f"{len(fit.steps)} steps; smooth model orders (Kg order): "
+                  + " ".join(map(str, cal.smooth.orders.tolist())))
+
+
+@app.command("thermal-report")
+def thermal_report(
+    calibration: Annotated[Path, typer.Argument(help="Thermal calibration file from 'gyrocal thermal'.")],
+    test: Annotated[Path, typer.Argument(help="Test recording (or folder) with t, gx, gy, gz, temp, table_rate, axis.")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Report folder to write.")],
+    units: Annotated[str | None, typer.Option("--units", help="Unit of the test data (default: the calibration's input unit).")] = None,
+    columns: Columns = None,
+    sample_rate: SampleRate = None,
+    sensitivity: Sensitivity = None,
+    settle: Settle = 2.0,
+    full_scale: FullScale = None,
+    temp_tolerance: TempTol = 2.0,
+    out_of_range: Annotated[OutOfRangePolicy, typer.Option(
+        "--out-of-range", help="Test temperatures outside the calibrated range: refuse, clamp or extrapolate.")
+    ] = OutOfRangePolicy.refuse,
+    figures: Annotated[bool, typer.Option("--figures/--no-figures", help="Draw the PNG figures.")] = True,
+) -> None:
+    """Compare uncompensated, traditional, Lagrange and smooth compensation on a test recording."""
+    from ..errors import OutOfRangeError
+    from ..thermal import load_thermal
+    from ..thermal.evaluate import evaluate
+    from ..thermal.report import write_report
+
+    cal = load_thermal(calibration)
+    units = units or cal.input_units
+    with _print_warnings():
+        recs, _ = _read(test, units, columns, sample_rate, sensitivity, cal.output_units if units == "counts" else None)
+        try:
+            ev = evaluate(cal, recs, settle=settle, temp_tolerance=temp_tolerance, out_of_range=out_of_range.value,
+                          full_scale=_full_scale(full_scale, units, cal.output_units, sensitivity))
+        except OutOfRangeError as exc:  # name the flag, not the keyword
+            raise OutOfRangeError(str(exc).replace("pass out_of_range=", "pass --out-of-range ")) from None
+        paths = write_report(cal, ev, output, figures=figures)
+    from rich.markup import escape
+    from rich.table import Table
+
+    table = Table(title=escape(f"RMS error [{cal.output_units}] per rotating axis / gyro axis"))
+    for col in ("rot", "gyro", "uncomp.", "traditional", "lagrange", "smooth", "lagr. vs trad."):
+        table.add_column(col, justify="right")
+    for r in ev.summary(cal.output_units):
+        table.add_row(r["rotating_axis"], r["gyro_axis"], *(f"{r[m + '_rms']:.4g}" for m in
+                      ("uncompensated", "traditional", "lagrange", "smooth")), f"{r['lagrange_vs_traditional_pct']:.1f} %")
+    console.print(table)
+    console.print(f"wrote {len(paths)} files to {output}")

@@ -10,8 +10,16 @@ from .first_moment import FirstMoment, first_moment_batch
 from .paper_lm import PaperLM, paper_lm_batch
 
 __all__ = [
-    "Algorithm1", "PaperLM", "FirstMoment", "FitResult", "BatchFit", "Method",
-    "algorithm1_batch", "paper_lm_batch", "first_moment_batch", "make_estimator",
+    "Algorithm1",
+    "BatchFit",
+    "FirstMoment",
+    "FitResult",
+    "Method",
+    "PaperLM",
+    "algorithm1_batch",
+    "first_moment_batch",
+    "make_estimator",
+    "paper_lm_batch",
 ]
 
 

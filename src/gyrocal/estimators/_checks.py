@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import DegenerateDesignError, NonPhysicalEstimateError, ConvergenceError
+from ..errors import ConvergenceError, DegenerateDesignError, NonPhysicalEstimateError
 
 N_PARAMS = 6
 
@@ -51,3 +51,19 @@ def require_converged(converged: np.ndarray, iterations: np.ndarray, method: str
             "check the windows and the reference, or raise max_iter",
             iterations=int(iterations[i]),
         )
+
+
+def require_every_axis(mean: np.ndarray, static: np.ndarray) -> np.ndarray:
+    """Refuse a design with no rotation about some axis; return each window's dominant axis.
+
+    `mean` is one gyro's window means (n, 3); the dominant axis of a window is the one
+    with the largest mean reading. Without a turn about an axis its scale factor is
+    invisible (a small misalignment makes the problem ill-posed rather than singular).
+    """
+    dominant = np.abs(mean).argmax(axis=-1)
+    for j in range(3):
+        if not np.any((dominant == j) & ~static):
+            raise DegenerateDesignError(
+                f"no rotation about the {'xyz'[j]} axis; k{'xyz'[j]} cannot be observed. Turn about every axis"
+            )
+    return dominant

@@ -7,7 +7,7 @@ A single problem is a batch of one, so there is one code path.
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
@@ -33,7 +33,7 @@ def batched_lm(
     max_iter : int
         Most iterations per item.
     xtol, gtol : float
-        Converged when an accepted step is below ``xtol`` relative to ``|p|``, or when
+        Converged when an accepted step's norm is below ``xtol`` relative to ``||p||``, or when
         the gradient is orthogonal to the residual within ``gtol`` (MINPACK's test).
 
     Returns
@@ -76,7 +76,8 @@ def batched_lm(
         cost = np.where(better, cost_try, cost)
         lam = np.where(better, np.maximum(lam * 0.1, 1e-12), lam * 10.0)
         iterations += ~done
-        small = np.all(np.abs(dp) <= xtol * (np.abs(p) + xtol), axis=1)
+        # MINPACK's test on the step norm: per-element tests never pass for a parameter near 0.
+        small = np.linalg.norm(dp, axis=1) <= xtol * (np.linalg.norm(p, axis=1) + xtol)
         newly = better & small
         converged |= newly
         done |= newly | (lam > 1e16)

@@ -9,13 +9,14 @@ import numpy as np
 
 from ..models import ScaleBias
 
-__all__ = ["Method", "FitResult", "BatchFit"]
+__all__ = ["BatchFit", "FitResult", "Method"]
 
 Method = Literal["first-moment", "algorithm1", "lm"]
 
 
 def _frozen(value) -> np.ndarray:
-    arr = np.array(value, dtype=float)
+    """A read-only float view of `value`: no copy of large batch arrays that are already float."""
+    arr = np.asarray(value, dtype=float).view()
     arr.setflags(write=False)
     return arr
 
@@ -38,7 +39,10 @@ class BatchFit:
         Per-sample noise standard deviation the covariance assumed [reading units].
     history : ndarray, shape (B, iterations_max + 1, 6)
         ``(k, b)`` after each iteration (index 0 is the initial estimate); rows past an
-        item's own iteration count repeat its final value.
+        item's own iteration count repeat its final value. For the first-moment closed
+        form, index 0 is the ``beta0 = 0`` estimate and each row a Newton step on ``beta0``.
+
+    Large arrays may be read-only views of batch-last storage rather than C-contiguous.
     """
 
     method: Method
@@ -79,7 +83,7 @@ class BatchFit:
             return None
         return np.sqrt(np.diagonal(self.covariance, axis1=1, axis2=2))
 
-    def item(self, i: int) -> "FitResult":
+    def item(self, i: int) -> FitResult:
         """The single-gyro result at batch index `i`."""
         n = int(self.iterations[i])
         return FitResult(

@@ -31,9 +31,12 @@ def algorithm1_batch(obs: ObservationSet, *, tol: float = 1e-6, max_iter: int = 
         Most ``beta0`` updates before :class:`~gyrocal.errors.ConvergenceError`.
     """
     X, Y = regressors(obs)
-    XtX = np.einsum("bni,bnj->bij", X, X)
-    rhs = np.stack([np.einsum("bni,bn->bi", X, Y), X.sum(axis=1)], axis=-1)
-    uv = np.linalg.solve(XtX, rhs)
+    rhs = np.stack([Y, np.ones_like(Y)], axis=-1)
+    if X.shape[1] == X.shape[2]:
+        uv = np.linalg.solve(X, rhs)  # six windows: (X^T X)^-1 X^T = X^-1, one solve fewer
+    else:
+        Xt = X.transpose(0, 2, 1)
+        uv = np.linalg.solve(Xt @ X, Xt @ rhs)
     u, v = uv[..., 0], uv[..., 1]
     beta = u.copy()  # beta0 = 0: the initial estimate
     history = [beta.copy()]
@@ -52,10 +55,10 @@ def algorithm1_batch(obs: ObservationSet, *, tol: float = 1e-6, max_iter: int = 
             break
     require_converged(~active, iterations, "Algorithm 1")
     k, b = beta_to_kb(beta, "Algorithm 1")
-    residuals = np.einsum("bni,bi->bn", X, beta) + gamma(beta)[:, None] - Y
+    residuals = (X @ beta[..., None])[..., 0] + gamma(beta)[:, None] - Y
     return BatchFit(
         method="algorithm1", k=k, b=b, iterations=iterations, converged=~active, residuals=residuals,
-        covariance=None, noise_std=None, history=kb_history(np.stack(history, axis=1)),
+        covariance=None, noise_std=None, history=kb_history(np.stack(history)).transpose(1, 0, 2),
     )
 
 

@@ -21,11 +21,13 @@ import numpy as np
 
 from ..errors import DegenerateDesignError, InputError
 from ..observations import ObservationSet
-from ._checks import require_converged, require_count, require_full_rank, require_positive_k2
+from ._checks import require_converged, require_count, require_every_axis, require_full_rank, require_positive_k2
+from ._exact6 import exact_six
 from ._lm import batched_lm
+from ._noise import pooled_noise_var
 from ._result import BatchFit, FitResult
 
-__all__ = ["FirstMoment", "first_moment_batch", "residuals_and_jacobian", "sandwich_covariance", "estimate_noise_var"]
+__all__ = ["FirstMoment", "estimate_noise_var", "first_moment_batch", "residuals_and_jacobian", "sandwich_covariance"]
 
 PARAM_NAMES = ("kx", "ky", "kz", "bx", "by", "bz")
 
@@ -69,19 +71,10 @@ def estimate_noise_var(obs: ObservationSet) -> np.ndarray:
 
     Static windows are used when there are any. Otherwise each rotation window lends
     its two non-rotating axes, whose first differences hold sensor noise but no
-    speed jitter.
+    speed jitter (:func:`gyrocal.estimators._noise.pooled_noise_var`).
     """
-    weights = obs.count * obs.static
-    if weights.sum() > 0:
-        w = np.broadcast_to(weights[None, :, None], obs.noise_var.shape)
-    else:
-        dominant = np.abs(obs.mean).argmax(axis=-1)  # (B, n)
-        w = obs.count[None, :, None] * (dominant[..., None] != np.arange(3))
-    total = w.sum(axis=1)
-    pooled = (w * obs.noise_var).sum(axis=1) / np.where(total > 0, total, 1.0)
-    # An axis never seen off-rotation borrows the mean of the others.
-    fallback = pooled.sum(axis=1, keepdims=True) / np.maximum((total > 0).sum(axis=1, keepdims=True), 1)
-    return np.where(total > 0, pooled, fallback)
+    obs = obs.as_batch()
+    return pooled_noise_var(obs.mean.transpose(1, 2, 0), obs.noise_var.transpose(1, 2, 0), obs.count, obs.static).T
 
 
 def sandwich_covariance(J: np.ndarray, S: np.ndarray, noise_var: np.ndarray) -> np.ndarray:
@@ -107,13 +100,10 @@ def initial_guess(obs: ObservationSet) -> np.ndarray:
     """
     B = obs.mean.shape[0]
     p0 = np.empty((B, 6))
+    require_every_axis(obs.mean[0], obs.static)
     dominant = np.abs(obs.mean).argmax(axis=-1)
     for j in range(3):
         on_axis = (dominant == j) & ~obs.static  # (B, n)
-        if not on_axis[0].any():
-            raise DegenerateDesignError(
-                f"no rotation about the {'xyz'[j]} axis; k{'xyz'[j]} cannot be observed. Turn about every axis"
-            )
         use = on_axis | obs.static
         x = np.where(on_axis, np.sign(obs.mean[..., j]) * obs.rate, 0.0)  # signed reference
         w = use * obs.count
@@ -135,6 +125,7 @@ def first_moment_batch(
     *,
     noise_var=None,
     max_iter: int = 100,
+    closed_form: bool = True,
 ) -> BatchFit:
     """Fit ``(k, b)`` from first-moment equations for every gyro of a batch.
 
@@ -147,12 +138,58 @@ def first_moment_batch(
         omitted (:func:`estimate_noise_var`).
     max_iter : int
         Most Levenberg–Marquardt iterations.
+    closed_form : bool
+        With exactly six rotation windows and no static window, solve the six equations
+        directly (one 6x6 inverse and a scalar Newton iteration per gyro; see
+        :mod:`gyrocal.estimators._exact6`), which gives the least-squares solution at a
+        fraction of the cost. Gyros it cannot solve fall back to Levenberg–Marquardt.
+        ``False`` always uses Levenberg–Marquardt. ``iterations`` counts Newton steps on
+        ``beta0`` for the closed form and LM steps otherwise.
     """
     obs = obs.as_batch()
-    n_rot = int((~obs.static).sum())
-    require_count(n_rot + 3 * int(obs.static.sum()), f"{n_rot} rotation and {int(obs.static.sum())} static window(s)")
+    n_rot, n_sta = int((~obs.static).sum()), int(obs.static.sum())
+    require_count(n_rot + 3 * n_sta, f"{n_rot} rotation and {n_sta} static window(s)")
+    if not (closed_form and n_rot == 6 and n_sta == 0):
+        return _lm_fit(obs, _noise_var(obs, noise_var), max_iter)
+    initial_guess(obs.take([0]))  # the design checks, with their specific messages
+    # Without a known noise level, the closed form estimates it chunk by chunk, in cache.
+    known = None if noise_var is None else _noise_var(obs, noise_var)
+    k, b, cov, steps, ok, resid, history, nv = exact_six(obs.mean, obs.rate, obs.count, known, obs.noise_var)
+    ok &= steps <= max_iter
+    if not ok.all():
+        rest = _lm_fit(obs.take(~ok), nv[~ok], max_iter)
+        k[~ok], b[~ok], cov[~ok], steps[~ok] = rest.k, rest.b, rest.covariance, rest.iterations
+        resid[~ok] = rest.residuals
+        depth = max(history.shape[1], rest.history.shape[1])
+        history = _pad_history(history, depth)
+        history[~ok] = _pad_history(rest.history, depth)
+    _, J, _ = residuals_and_jacobian(np.concatenate([k[:1], b[:1]], axis=1), obs.take([0]))
+    require_full_rank(J[0], PARAM_NAMES, "the windows")
+    return BatchFit(
+        method="first-moment", k=k, b=b, iterations=steps, converged=np.ones(len(k), dtype=bool), residuals=resid,
+        covariance=cov, noise_std=np.sqrt(nv), history=history,
+    )
+
+
+def _pad_history(history: np.ndarray, depth: int) -> np.ndarray:
+    """(B, depth, P) history, repeating the final row."""
+    extra = depth - history.shape[1]
+    return np.concatenate([history, np.repeat(history[:, -1:], extra, axis=1)], axis=1) if extra else history
+
+
+def _noise_var(obs: ObservationSet, noise_var) -> np.ndarray:
+    if noise_var is None:
+        return estimate_noise_var(obs)
+    nv = np.broadcast_to(np.asarray(noise_var, dtype=float), (obs.batch_size, 3))
+    if not np.all(np.isfinite(nv)) or np.any(nv < 0):
+        raise InputError(f"noise_var must be finite and >= 0 with shape (3,) or (B, 3), got {noise_var!r}")
+    return nv
+
+
+def _lm_fit(obs: ObservationSet, nv: np.ndarray, max_iter: int) -> BatchFit:
+    """The general path: Levenberg–Marquardt from the per-axis linear start."""
     p0 = initial_guess(obs)
-    fun = lambda p: residuals_and_jacobian(p, obs)[:2]  # noqa: E731
+    fun = lambda p: residuals_and_jacobian(p, obs)[:2]
     p, iterations, converged, residuals, history = batched_lm(fun, p0, max_iter=max_iter)
     require_converged(converged, iterations, "first-moment least squares")
     # The norm equations cannot see the sign of k; a positive scale is the physical one.
@@ -161,12 +198,6 @@ def first_moment_batch(
     require_positive_k2(p[:, :3] ** 2, "first-moment least squares")
     _, J, S = residuals_and_jacobian(p, obs)
     require_full_rank(J[0], PARAM_NAMES, "the windows")
-    if noise_var is None:
-        nv = estimate_noise_var(obs)
-    else:
-        nv = np.broadcast_to(np.asarray(noise_var, dtype=float), (len(p), 3))
-        if not np.all(np.isfinite(nv)) or np.any(nv < 0):
-            raise InputError(f"noise_var must be finite and >= 0, got {noise_var!r}")
     return BatchFit(
         method="first-moment", k=p[:, :3], b=p[:, 3:], iterations=iterations, converged=converged,
         residuals=residuals, covariance=sandwich_covariance(J, S, nv), noise_std=np.sqrt(nv), history=history,
@@ -183,11 +214,15 @@ class FirstMoment:
         Known per-sample white-noise standard deviation [reading units], for example
         from ``gyrocal noise``. Estimated from the windows when omitted.
     max_iter : int
-        Most Levenberg–Marquardt iterations.
+        Most Levenberg–Marquardt iterations (and Newton steps of the closed form).
+    closed_form : bool
+        Solve exactly-determined problems (six rotation windows) in closed form; see
+        :func:`first_moment_batch`.
     """
 
     noise_std: float | tuple[float, float, float] | None = None
     max_iter: int = 100
+    closed_form: bool = True
 
     def _noise_var(self):
         return None if self.noise_std is None else np.broadcast_to(np.square(np.asarray(self.noise_std, float)), (3,))
@@ -198,4 +233,5 @@ class FirstMoment:
 
     def fit_batch(self, obs: ObservationSet) -> BatchFit:
         """Estimate every gyro of a batch."""
-        return first_moment_batch(obs, noise_var=self._noise_var(), max_iter=self.max_iter)
+        return first_moment_batch(obs, noise_var=self._noise_var(), max_iter=self.max_iter,
+                                  closed_form=self.closed_form)

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..observations import ObservationSet
-from ._checks import require_count, require_full_rank, require_positive_k2
+from ._checks import require_count, require_every_axis, require_full_rank, require_positive_k2
 
 BETA_NAMES = ("beta1", "beta2", "beta3", "beta4", "beta5", "beta6")
 
@@ -18,6 +18,7 @@ def regressors(obs: ObservationSet) -> tuple[np.ndarray, np.ndarray]:
     """Eq. 7 and 8: X (B, n, 6) ``[m_x^2, m_y^2, m_z^2, m_x, m_y, m_z]`` (window means) and Y (B, n)."""
     obs = obs.as_batch()
     require_count(len(obs), f"{len(obs)} observation(s)")
+    require_every_axis(obs.mean[0], obs.static)
     X = np.concatenate([obs.mean_sq, obs.mean], axis=-1)
     require_full_rank(X[0], BETA_NAMES, "the observations")
     return X, obs.rate**2
@@ -38,6 +39,4 @@ def kb_history(beta_history: np.ndarray) -> np.ndarray:
     """(k, b) rows from beta rows, leaving non-physical rows as NaN."""
     b1 = beta_history[..., :3]
     with np.errstate(invalid="ignore", divide="ignore"):
-        k = np.where(b1 > 0, np.sqrt(np.abs(b1)), np.nan)
-        b = beta_history[..., 3:] / (2.0 * b1)
-    return np.concatenate([k, b], axis=-1)
+        return np.concatenate([np.sqrt(b1), beta_history[..., 3:] / (2.0 * b1)], axis=-1)

@@ -1,0 +1,120 @@
+/*
+ * gyrocal_cal.h: gyroscope calibration on a microcontroller (part of gyrocal, MIT licence).
+ *
+ * C99, float32 arithmetic, no dynamic memory, nothing from libc beyond <math.h>.
+ * All state lives in caller-owned structs; the library has no static data.
+ *
+ * Model convention (the same as the Python package):
+ *
+ *     w_true = matrix * (raw - offset)
+ *
+ * raw and offset in the sensor's units, matrix maps them to the output units.
+ * Seed 000 (eq. 1) writes g = diag(k) (m + b): matrix = diag(k), offset = -b.
+ * Seed 001 (eq. 12) writes w = K w~ + B: matrix = K^-1, offset = B.
+ *
+ * Every function that can fail returns a gyrocal_status_t; on failure the
+ * outputs are left untouched, so a caller never sees NaN parameters.
+ */
+#ifndef GYROCAL_CAL_H
+#define GYROCAL_CAL_H
+
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum {
+    GYROCAL_OK = 0,
+    GYROCAL_E_INPUT = 1,       /* NaN/inf input, too few samples or table nodes, bad flags */
+    GYROCAL_E_SINGULAR = 2,    /* a pivot fell below GYROCAL_PIVOT_RTOL: the design cannot fix the parameters */
+    GYROCAL_E_NONPHYSICAL = 3, /* an estimated k^2 <= 0 (wrong reference rate or units?) */
+    GYROCAL_E_NOCONV = 4,      /* no convergence within GYROCAL_MAX_ITER iterations */
+    GYROCAL_E_RANGE = 5        /* temperature outside the table and GYROCAL_THERMAL_CLAMP not given */
+} gyrocal_status_t;
+
+/* Six observations: the G-optimal design of seed 000 (+x, -x, +y, -y, +z, -z turns). */
+#define GYROCAL_N_OBS 6
+/* Relative pivot threshold of the 6x6 and 3x3 eliminations (on rate-normalised entries). */
+#ifndef GYROCAL_PIVOT_RTOL
+#define GYROCAL_PIVOT_RTOL 1e-5f
+#endif
+/* Stop when sum|delta beta| <= GYROCAL_REL_TOL * sum|beta| (beta normalised by the largest rate):
+ * 16 float32 epsilons, the float32 stand-in for seed 000's absolute 1e-6. */
+#ifndef GYROCAL_REL_TOL
+#define GYROCAL_REL_TOL 1.9073486e-06f
+#endif
+#ifndef GYROCAL_MAX_ITER
+#define GYROCAL_MAX_ITER 50
+#endif
+
+/* Canonical correction w = matrix (raw - offset). */
+typedef struct {
+    float matrix[3][3];
+    float offset[3];
+} gyrocal_affine_t;
+
+/* Seed 000 parameters: g = diag(k) (m + b); b in the sensor's units, added to the reading. */
+typedef struct {
+    float k[3];
+    float b[3];
+} gyrocal_scale_bias_t;
+
+/* Seed 001 temperature table: n >= 3 strictly increasing nodes [degC] and one Kg 12-vector per
+ * node, eq. 14 order [Kxx,Kyy,Kzz,Kyx,Kzx,Kxy,Kzy,Kxz,Kyz,Bx,By,Bz]; K maps output units to
+ * sensor units, B is in sensor units. */
+typedef struct {
+    uint16_t n;
+    const float *temps;
+    const float (*kg)[12];
+} gyrocal_thermal_t;
+
+/* Flags of gyrocal_thermal_correct. */
+#define GYROCAL_THERMAL_CLAMP 1u /* clamp the temperature to the table instead of failing */
+
+/* Streaming window accumulator: compensated sums of deviations from the first sample. */
+typedef struct {
+    float first[3];
+    float s1[3], c1[3]; /* sum of d = x - first, and its Neumaier compensation */
+    float s2[3], c2[3]; /* sum of d^2, and its compensation */
+    uint32_t count;
+} gyrocal_accum_t;
+
+/* One window reduced for calibration: means [sensor units], means of squares [sensor units^2],
+ * and the reference rate magnitude [output units], e.g. 2*pi/T for a full turn lasting T. */
+typedef struct {
+    float mean[3];
+    float mean_sq[3];
+    float rate;
+} gyrocal_obs_t;
+
+/* w = matrix (raw - offset). */
+void gyrocal_correct(const gyrocal_affine_t *cal, const float raw[3], float out[3]);
+
+/* The canonical form of seed 000 parameters: matrix = diag(k), offset = -b. */
+void gyrocal_scale_bias_to_affine(const gyrocal_scale_bias_t *sb, gyrocal_affine_t *out);
+
+/* w = K(T)^-1 (raw - B(T)), Kg(T) by 3-node Lagrange interpolation (seed 001, eq. 21-22) over nodes
+ * s, s+1, s+2 with s = clamp(i - 2, 0, n - 3) and i the first node >= T. */
+gyrocal_status_t gyrocal_thermal_correct(const gyrocal_thermal_t *table, float temp, const float raw[3],
+                                         unsigned flags, float out[3]);
+
+void gyrocal_accum_reset(gyrocal_accum_t *acc);
+void gyrocal_accum_add(gyrocal_accum_t *acc, const float sample[3]);
+/* Window mean and mean of squares; `rate` is stored as the observation's reference. */
+gyrocal_status_t gyrocal_accum_finish(const gyrocal_accum_t *acc, float rate, gyrocal_obs_t *obs);
+
+/* Seed 000 Algorithm 1 on exactly six observations (regressors: means of squares and means). */
+gyrocal_status_t gyrocal_algorithm1(const gyrocal_obs_t obs[GYROCAL_N_OBS], gyrocal_scale_bias_t *out,
+                                    int *iterations);
+
+/* First-moment estimator on exactly six rotation observations: sum_j k_j^2 (mean_j + b_j)^2 = rate^2,
+ * solved exactly (Newton on beta0). */
+gyrocal_status_t gyrocal_first_moment(const gyrocal_obs_t obs[GYROCAL_N_OBS], gyrocal_scale_bias_t *out,
+                                      int *iterations);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* GYROCAL_CAL_H */

@@ -1,0 +1,178 @@
+"""From parsed columns to a checked :class:`~gyrocal.recording.Recording` in internal units."""
+
+from __future__ import annotations
+
+import math
+from typing import Literal
+
+import numpy as np
+
+from .._validation import positive
+from ..errors import InputError, NonFiniteInputError, SaturationError, UnitError
+from ..recording import Recording
+from ..units import parse_input_unit, parse_rate_unit, unit_factor
+from ._columns import NUMERIC
+from .saturation import find_saturation
+
+SaturationPolicy = Literal["error", "drop", "ignore"]
+
+#: No MEMS gyro measures beyond about 2000 deg/s (4000 for a few); above this, rad/s is a unit mistake.
+MAX_PLAUSIBLE_RAD_S = math.radians(2000.0)
+MAX_PLAUSIBLE_DEG_S = 5000.0
+
+
+def _check_finite(data: dict, source: str) -> None:
+    # a sum is one fast pass and is finite when every term is (bar overflow, rechecked below)
+    if all(np.isfinite(np.sum(data[c])) for c in NUMERIC if c in data):
+        return
+    bad = None
+    for c in NUMERIC:
+        if c in data and not np.isfinite(data[c]).all():
+            col_bad = ~np.isfinite(data[c])
+            bad = col_bad if bad is None else bad | col_bad
+    if bad is None:
+        return  # the sum overflowed; every value is finite
+    first = int(np.argmax(bad))
+    cols = [c for c in NUMERIC if c in data and not np.isfinite(data[c][first])]
+    raise NonFiniteInputError(
+        f"{source}: {int(bad.sum())} row(s) hold NaN, inf or empty cells, first at data row {first + 1} "
+        f"(column {', '.join(cols)}); remove or fill those rows first"
+    )
+
+
+def _check_time(t: np.ndarray, source: str) -> float:
+    """Check that time increases; return the nominal rate (median step) [Hz]."""
+    increasing = t[1:] > t[:-1]
+    if not increasing.all():
+        i = int(np.argmin(increasing))
+        what = "a duplicated timestamp" if t[i + 1] == t[i] else "time going backwards"
+        raise InputError(
+            f"{source}: {what} at data row {i + 2} (t={t[i]!r} then {t[i + 1]!r}); "
+            "times must increase strictly: sort the log and drop repeated rows"
+        )
+    # the median of up to 100 000 evenly spread steps: nominal, and cheap on long logs
+    i = np.linspace(0, len(t) - 2, min(len(t) - 1, 100_000)).astype(np.intp)
+    return 1.0 / float(np.median(t[i + 1] - t[i]))
+
+
+def _check_units(raw: np.ndarray, unit: str, sensitivity: float | None, source: str) -> None:
+    peak = max(float(raw.max()), -float(raw.min())) if raw.size else 0.0
+    if unit == "counts":
+        if not np.array_equal(raw, np.round(raw)):
+            i = int(np.argmax((raw != np.round(raw)).any(axis=1)))
+            raise UnitError(
+                f"{source}: units are counts but data row {i + 1} holds non-integer readings {raw[i].tolist()}; "
+                "raw counts are integers: declare the rate unit instead (--units deg/s or rad/s)"
+            )
+    elif unit == "rad/s" and peak > MAX_PLAUSIBLE_RAD_S:
+        raise UnitError(
+            f"{source}: rates reach {peak:.4g} rad/s ({math.degrees(peak):.4g} deg/s), beyond any MEMS gyro's range; "
+            "the data are almost surely in deg/s: use --units deg/s (or --no-unit-check)"
+        )
+    elif unit == "deg/s" and peak > MAX_PLAUSIBLE_DEG_S and np.array_equal(raw, np.round(raw)):
+        raise UnitError(
+            f"{source}: integer rates reach {peak:.6g} deg/s, beyond any MEMS gyro's range; "
+            "these look like raw counts: use --units counts (with --sensitivity if known)"
+        )
+
+
+def _check_saturation(raw, full_scale, policy: str, source: str) -> np.ndarray | None:
+    """Rows to keep (None: all)."""
+    if policy not in ("error", "drop", "ignore"):
+        raise InputError(f"saturation={policy!r} is not accepted; use 'error', 'drop' or 'ignore'")
+    if policy == "ignore":
+        return None
+    mask = find_saturation(raw, full_scale)
+    if not mask.any():
+        return None
+    if policy == "drop":
+        return ~mask.any(axis=1)
+    j = int(np.argmax(mask.any(axis=0)))
+    rows = np.flatnonzero(mask[:, j])
+    level = float(np.max(np.abs(raw[rows, j])))
+    stop = rows[0] + int(np.argmax(np.r_[np.diff(rows) != 1, True]))
+    raise SaturationError(
+        f"{source}: axis {'xyz'[j]} is stuck at full scale (+-{level:.6g}) in {len(rows)} sample(s), "
+        f"first at data rows {rows[0] + 1}-{stop + 1}; those readings are not measurements: "
+        "record again with a larger range or slower turns, or drop them (saturation='drop', CLI --saturation drop)"
+    )
+
+
+def _rates_block(gx, gy, gz) -> np.ndarray:
+    """(N, 3) rates: the reader's own block when gx, gy, gz are its columns, else a new copy."""
+    base = gx.base
+    if (
+        isinstance(base, np.ndarray) and base.ndim == 2 and base.shape == (len(gx), 3) and base.dtype == np.float64
+        and base.flags.c_contiguous and all(c.base is base for c in (gy, gz))
+        and [c.ctypes.data - base.ctypes.data for c in (gx, gy, gz)] == [0, 8, 16]
+    ):
+        return base
+    return np.column_stack([gx, gy, gz]).astype(float, copy=False)
+
+
+def build_recording(
+    data: dict,
+    extra: dict,
+    *,
+    source: str,
+    units: str,
+    sample_rate: float | None = None,
+    sensitivity: float | None = None,
+    output_units: str | None = None,
+    check_units: bool = True,
+    saturation: SaturationPolicy = "error",
+    full_scale: float | None = None,
+) -> Recording:
+    """Check parsed columns and convert them to a :class:`Recording` (see :func:`gyrocal.io.read_recording`)."""
+    unit = parse_input_unit(units, "units")
+    out_unit = parse_rate_unit(output_units, "output_units") if output_units is not None else "deg/s"
+    if sensitivity is not None:
+        if unit != "counts":
+            raise UnitError(f"sensitivity={sensitivity!r} applies only to units='counts', got units={units!r}")
+        sensitivity = positive("sensitivity", sensitivity)
+    n = len(data["gx"])
+    if n < 2:
+        raise InputError(f"{source}: {'no data rows' if n == 0 else 'a single data row'}; a recording needs at least two samples")
+    _check_finite(data, source)
+    raw = _rates_block(data["gx"], data["gy"], data["gz"])
+    if "t" in data:
+        t, has_time = np.asarray(data["t"], dtype=float), True  # a time column wins over sample_rate
+        fs = _check_time(t, source)
+    elif sample_rate is not None:
+        fs = positive("sample_rate", sample_rate)
+        t, has_time = np.arange(n) / fs, False
+    else:
+        raise InputError(
+            f"{source}: no time column (t, time, timestamp, ...); give the sample rate "
+            "(sample_rate=HZ, CLI --sample-rate HZ) or map the time column (--columns t=NAME)"
+        )
+    if check_units:
+        _check_units(raw, unit, sensitivity, source)
+    keep = _check_saturation(raw, full_scale, saturation, source)
+    if unit == "counts":
+        factor = 1.0 if sensitivity is None else unit_factor(out_unit) / sensitivity
+        table_factor = unit_factor(out_unit)  # a table's rate is physical, never counts
+    else:
+        factor = table_factor = unit_factor(unit)
+    gyro = raw
+    if factor != 1.0:
+        gyro *= factor  # raw is this function's own array
+    fields = {
+        "t": t,
+        "gyro": gyro,
+        "temp": data.get("temp"),
+        "table_rate": None if "table_rate" not in data else data["table_rate"] * table_factor,
+        "axis": None if "axis" not in data else np.char.strip(np.asarray(data["axis"], dtype=str)),
+        "extra": dict(extra),
+    }
+    if keep is not None:
+        fields = {k: (v[keep] if isinstance(v, np.ndarray) else v) for k, v in fields.items()}
+        fields["extra"] = {k: np.asarray(v)[keep] for k, v in extra.items()}
+    return Recording(
+        **fields,
+        units="counts" if unit == "counts" and sensitivity is None else "rad/s",
+        source_units=unit,
+        sample_rate=fs,
+        has_time=has_time,
+        sensitivity=sensitivity,
+    )

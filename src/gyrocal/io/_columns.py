@@ -1,0 +1,119 @@
+"""Which file column holds which quantity: canonical names, aliases and user mappings."""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping, Sequence
+
+from ..errors import InputError
+
+#: Canonical column names, in the order a recording uses them.
+CANONICAL = ("t", "gx", "gy", "gz", "temp", "table_rate", "axis")
+REQUIRED = ("gx", "gy", "gz")
+#: Columns parsed as numbers; ``axis`` is text.
+NUMERIC = ("t", "gx", "gy", "gz", "temp", "table_rate")
+
+_RATE_STEMS = ("g", "gyr", "gyro", "gyroscope", "w", "omega", "rate", "angularvelocity", "angvel", "av")
+_ALIASES: dict[str, set[str]] = {
+    "t": {"t", "time", "times", "timestamp", "timestamps", "ts", "tsec", "timesec", "seconds", "sec", "elapsed", "elapsedtime"}
+    | {f"{stem}{u}" for stem in ("t", "time", "timestamp", "stamp") for u in ("ms", "us", "ns", "µs")},
+    "temp": {"temp", "temperature", "tempc", "temperaturec", "tdegc", "tempdegc", "gyrtemp", "gyrotemp", "imutemp", "dietemp"},
+    "table_rate": {"tablerate", "tablespeed", "turntablerate", "tablew", "tableomega"},
+    "axis": {"axis", "tableaxis"},
+}
+_RATE_SUFFIXES = ("", "dps", "degs", "degps", "rads", "radps", "raw", "lsb")
+for _a in "xyz":
+    _ALIASES[f"g{_a}"] = {f"{stem}{_a}{unit}" for stem in _RATE_STEMS for unit in _RATE_SUFFIXES} | {
+        f"{_a}{stem}" for stem in ("gyr", "gyro", "rate")
+    }
+
+_BRACKETS = re.compile(r"[\(\[\{].*?[\)\]\}]")
+_SEPARATORS = re.compile(r"[\s_\-\.:/]+")
+
+
+def normalise(name: str) -> str:
+    """Lower case, units in brackets and separators removed: ``'Gyro_X [deg/s]'`` -> ``'gyrox'``."""
+    return _SEPARATORS.sub("", _BRACKETS.sub("", str(name)).strip().lower())
+
+
+def parse_columns(spec: str | Mapping[str, str] | None) -> dict[str, str]:
+    """Turn ``'gx=gyroX,gy=gyroY'`` (the CLI syntax) or a mapping into ``{canonical: file name}``."""
+    if spec is None:
+        return {}
+    if isinstance(spec, str):
+        pairs: dict[str, str] = {}
+        for item in filter(None, (s.strip() for s in spec.split(","))):
+            key, sep, value = item.partition("=")
+            if not sep or not key.strip() or not value.strip():
+                raise InputError(f"columns entry {item!r} is not NAME=COLUMN; write for example 'gx=gyroX,gy=gyroY,gz=gyroZ'")
+            pairs[key.strip()] = value.strip()
+        spec = pairs
+    out = {}
+    for key, value in dict(spec).items():
+        canon = key.strip().lower()
+        if canon not in CANONICAL:
+            raise InputError(f"columns key {key!r} is not a known quantity; use one of {', '.join(CANONICAL)}")
+        out[canon] = str(value)
+    return out
+
+
+def _found(names: Sequence[str]) -> str:
+    shown = ", ".join(repr(n) for n in names[:40])
+    return shown + (f", ... ({len(names)} in all)" if len(names) > 40 else "")
+
+
+def resolve(names: Sequence[str], columns: Mapping[str, str] | None, source: str) -> dict[str, str]:
+    """Map canonical names to the file's column names.
+
+    Explicit `columns` win; then an exact canonical name (any case); then an alias, only
+    when a single file column matches it.
+
+    Raises
+    ------
+    InputError
+        A mapped column is absent, an alias is ambiguous, or ``gx, gy, gz`` cannot be found.
+    """
+    names = [str(n) for n in names]
+    by_lower = {}
+    for n in names:
+        by_lower.setdefault(n.strip().lower(), n)
+    mapping: dict[str, str] = {}
+    for canon, wanted in parse_columns(columns).items():
+        hit = wanted if wanted in names else by_lower.get(wanted.strip().lower())
+        if hit is None:
+            raise InputError(f"{source}: column {wanted!r} (given for {canon}) is not in the file; columns found: {_found(names)}")
+        mapping[canon] = hit
+    taken = set(mapping.values())
+    for canon in CANONICAL:
+        if canon in mapping:
+            continue
+        if canon in by_lower and by_lower[canon] not in taken:
+            mapping[canon] = by_lower[canon]
+            taken.add(mapping[canon])
+            continue
+        hits = [n for n in names if n not in taken and normalise(n) in _ALIASES[canon]]
+        if len(hits) == 1:
+            mapping[canon] = hits[0]
+            taken.add(hits[0])
+        elif len(hits) > 1 and (canon in REQUIRED or canon == "t"):
+            raise InputError(
+                f"{source}: several columns could be {canon} ({_found(hits)}); "
+                f"say which with columns, e.g. --columns {canon}={hits[0]}"
+            )
+    missing = [c for c in REQUIRED if c not in mapping]
+    if missing:
+        raise InputError(
+            f"{source}: no column for {', '.join(missing)}; columns found: {_found(names)}; "
+            "map them with --columns gx=NAME,gy=NAME,gz=NAME"
+        )
+    return mapping
+
+
+_TIME_UNITS = {"ms": 1e-3, "msec": 1e-3, "us": 1e-6, "usec": 1e-6, "µs": 1e-6, "ns": 1e-9, "nsec": 1e-9}
+_TIME_UNIT_TOKEN = re.compile(r"(?:^|[\s_\-\[\(\{])(ms|msec|us|usec|µs|ns|nsec)(?:$|[\s_\-\]\)\}])", re.IGNORECASE)
+
+
+def time_scale(name: str) -> float:
+    """Seconds per unit of a time column, read from its name (``time_ms``, ``t [us]``, ``stamp_ns``); 1 otherwise."""
+    hit = _TIME_UNIT_TOKEN.search(str(name))
+    return _TIME_UNITS[hit.group(1).lower()] if hit else 1.0

@@ -1,0 +1,124 @@
+"""One entry point for every recording format."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from ..errors import InputError
+from ..recording import Recording
+from ._build import SaturationPolicy, build_recording
+
+__all__ = ["read_recording", "TEXT_SUFFIXES", "BAG_SUFFIXES"]
+
+TEXT_SUFFIXES = (".csv", ".txt", ".tsv", ".dat")
+BAG_SUFFIXES = (".bag", ".db3", ".mcap")
+
+
+def _kind(path: Path) -> str:
+    if path.is_dir():
+        if (path / "metadata.yaml").is_file() or any(path.glob("*.db3")) or any(path.glob("*.mcap")):
+            return "bag"
+        raise InputError(f"{path}: a folder, but not a ROS 2 bag (no metadata.yaml, .db3 or .mcap inside)")
+    suffix = path.suffix.lower()
+    if suffix in (".parquet", ".pq"):
+        return "parquet"
+    if suffix in BAG_SUFFIXES:
+        return "bag"
+    with open(path, "rb") as f:
+        magic = f.read(13)
+    if magic.startswith(b"PAR1"):
+        return "parquet"
+    if magic.startswith((b"#ROSBAG V2.0", b"\x89MCAP", b"SQLite format")):
+        return "bag"
+    return "text"  # .csv, .txt, .tsv, .dat and anything else that reads as a table
+
+
+def read_recording(
+    path: str | os.PathLike,
+    *,
+    units: str,
+    columns: dict[str, str] | str | None = None,
+    sample_rate: float | None = None,
+    sensitivity: float | None = None,
+    output_units: str | None = None,
+    topic: str | None = None,
+    check_units: bool = True,
+    saturation: SaturationPolicy = "error",
+    full_scale: float | None = None,
+) -> Recording:
+    """Read a gyro recording from a file and check it.
+
+    Parameters
+    ----------
+    path : path-like
+        A delimited text table (``.csv .txt .tsv .dat``), a ``.parquet`` file, a ROS 1
+        ``.bag``, a ROS 2 bag folder or its ``.db3`` / ``.mcap`` file. The format is
+        chosen by suffix, then by the file's first bytes.
+    units : {"rad/s", "deg/s", "counts"}
+        Unit of the rate columns as written in the file.
+    columns : dict or str, optional
+        File column for each quantity, ``{"gx": "gyroX", ...}`` or ``"gx=gyroX,gy=gyroY"``.
+        Quantities: ``t`` [s], ``gx gy gz``, ``temp`` [degC], ``table_rate`` (signed, rate
+        units of the data), ``axis`` (x/y/z). Unmapped ones are found by name or by an
+        unambiguous alias (``time``, ``gyr_x``, ``gyro_x``, ``wx``, ...).
+    sample_rate : float, optional
+        Sampling rate [Hz]; required when there is no time column. A time column wins
+        when both are present.
+    sensitivity : float, optional
+        For counts: LSB per `output_units`. Converts counts to rad/s; without it the
+        recording keeps raw counts (``Recording.units == "counts"``).
+    output_units : {"rad/s", "deg/s"}, optional
+        Physical unit behind counts (default deg/s): the unit of `sensitivity` and of a
+        ``table_rate`` column in a counts file.
+    topic : str, optional
+        Bag topic, needed when several topics carry ``sensor_msgs/Imu``.
+    check_units : bool
+        Refuse likely unit mistakes: rad/s data beyond 2000 deg/s, integer "deg/s" data
+        beyond 5000 deg/s, non-integer counts.
+    saturation : {"error", "drop", "ignore"}
+        What to do with samples stuck at full scale (see :func:`find_saturation`).
+    full_scale : float, optional
+        Sensor limit in the file's units; without it, saturation is recognised by runs
+        of identical readings at the largest magnitude.
+
+    Returns
+    -------
+    Recording
+        Rates in rad/s (or counts), ``source_units`` = `units`, extra columns as text.
+
+    Raises
+    ------
+    InputError, NonFiniteInputError, UnitError, SaturationError, MissingDependencyError
+        With one sentence naming the file, the column or row, and what to do.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise InputError(f"recording {str(path)!r} does not exist")
+    kind = _kind(path)
+    if kind == "bag":
+        from .rosbag import read_bag_columns
+
+        if columns:
+            raise InputError("columns= does not apply to ROS bags (angular_velocity and header stamps are used)")
+        data, extra = read_bag_columns(path, topic)
+    elif kind == "parquet":
+        from .parquet import read_parquet_columns
+
+        data, extra = read_parquet_columns(path, columns)
+    else:
+        from .csvfile import read_csv_columns
+
+        data, extra = read_csv_columns(path, columns)
+    return build_recording(
+        data,
+        extra,
+        source=path.name,
+        units=units,
+        sample_rate=sample_rate,
+        sensitivity=sensitivity,
+        output_units=output_units,
+        check_units=check_units,
+        saturation=saturation,
+        full_scale=full_scale,
+    )

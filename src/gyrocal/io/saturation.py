@@ -1,0 +1,86 @@
+"""Samples stuck at a sensor's full scale."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._validation import positive
+from ..errors import InputError
+
+__all__ = ["find_saturation", "MIN_RUN"]
+
+#: Consecutive identical extreme samples that make a saturation run.
+MIN_RUN = 5
+
+
+def _long_runs(mask: np.ndarray, min_run: int) -> np.ndarray:
+    """Keep only the runs of True that are at least `min_run` long."""
+    idx = np.flatnonzero(mask)
+    out = np.zeros_like(mask)
+    if len(idx) < min_run:
+        return out
+    breaks = np.flatnonzero(np.diff(idx) != 1) + 1
+    lengths = np.diff(np.r_[0, breaks, len(idx)])
+    out[idx[np.repeat(lengths >= min_run, lengths)]] = True
+    return out
+
+
+def find_saturation(gyro, full_scale: float | None = None, *, min_run: int = MIN_RUN) -> np.ndarray:
+    """Mask of saturated samples, axis by axis.
+
+    Parameters
+    ----------
+    gyro : array_like, shape (N, 3)
+        Readings, in any unit (the same as `full_scale`).
+    full_scale : float, optional
+        Sensor limit [same unit as `gyro`]. Readings with ``|m| >= full_scale`` are saturated.
+        Without it, a sample is saturated when it belongs to a run of at least `min_run`
+        identical readings at the axis's largest magnitude ``+-max|m|``, and that level is
+        more than twice the axis's median magnitude (a quiet, constant axis is not saturated).
+    min_run : int
+        Shortest run of stuck samples counted when `full_scale` is not given.
+
+    Returns
+    -------
+    ndarray of bool, shape (N, 3)
+
+    Notes
+    -----
+    Without `full_scale` the test relies on sensor noise: a real reading at a constant
+    rate wanders by a few LSB, a clipped one does not. Noise-free simulated data at a
+    constant rate can therefore look saturated; pass `full_scale` (or opt out) there.
+    """
+    g = np.asarray(gyro)
+    if g.ndim != 2 or g.shape[1] != 3:
+        raise InputError(f"gyro must have shape (N, 3), got {g.shape}")
+    if full_scale is not None:
+        return np.abs(g) >= positive("full_scale", full_scale)
+    if int(min_run) < 1:
+        raise InputError(f"min_run must be >= 1, got {min_run!r}")
+    mask = np.zeros(g.shape, dtype=bool)
+    for j in range(3):
+        col = g[:, j]  # column by column: numpy reduces a strided 1-D view far faster than axis=0 of (N, 3)
+        if len(col) == 0:
+            continue
+        hi, lo = col.max(), col.min()
+        level = max(abs(hi), abs(lo))
+        if not np.isfinite(level) or level == 0:
+            continue
+        if abs(hi) != abs(lo):  # only one sign reaches the extreme: one comparison pass
+            stuck = col == (hi if abs(hi) > abs(lo) else lo)
+        else:
+            stuck = (col == level) | (col == -level)
+        if np.count_nonzero(stuck) < min_run:  # the common case: no pile-up at the extreme
+            continue
+        runs = _long_runs(stuck, int(min_run))
+        if runs.any() and level > 2.0 * np.median(np.abs(col)):
+            mask[:, j] = runs
+    return mask
+    level = np.maximum(np.abs(g.max(axis=0)), np.abs(g.min(axis=0)))  # whole-array passes, not per column
+    stuck = g == level
+    stuck |= g == -level
+    for j in np.flatnonzero((np.count_nonzero(stuck, axis=0) >= min_run) & (level > 0) & np.isfinite(level)):
+        runs = _long_runs(stuck[:, j], int(min_run))
+        if runs.any() and level[j] > 2.0 * np.median(np.abs(g[:, j])):
+            mask[:, j] = runs
+    return mask

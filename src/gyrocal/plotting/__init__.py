@@ -1,0 +1,6 @@
+"""Pictures of recordings, calibrations and studies (needs the ``plot`` extra).
+
+Each module draws into a caller's matplotlib ``Axes`` or ``Figure`` and returns the
+artists it made; none touches pyplot's global state. Import the module you need,
+for example ``from gyrocal.plotting.calibration import calibration_figure``.
+"""

@@ -1,0 +1,44 @@
+"""matplotlib without pyplot: a headless ``Figure`` and an atomic ``savefig``."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from .._atomic import atomic_path
+from ..errors import InputError, MissingDependencyError
+
+__all__ = ["new_figure", "save_figure"]
+
+_HINT = "plots need matplotlib: pip install 'gyrocal[plot]'"
+_FORMATS = ("png", "pdf", "svg")
+
+
+def new_figure(figsize: tuple[float, float] = (11.0, 7.0), **kwargs):
+    """A ``matplotlib.figure.Figure`` bound to the Agg canvas (no GUI, no pyplot state).
+
+    Parameters
+    ----------
+    figsize : tuple of float
+        Width and height [inch].
+    **kwargs
+        Passed to ``Figure`` (for example ``layout="constrained"``).
+    """
+    try:
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+    except ImportError:
+        raise MissingDependencyError(_HINT) from None
+    fig = Figure(figsize=figsize, **kwargs)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def save_figure(fig, path: str | os.PathLike, dpi: int = 110) -> None:
+    """Write `fig` to `path` atomically; the format follows the suffix (png, pdf or svg)."""
+    fmt = Path(path).suffix.lower().lstrip(".")
+    if fmt not in _FORMATS:
+        got = Path(path).suffix or "no suffix"
+        raise InputError(f"plot path {str(path)!r} must end in .png, .pdf or .svg, got {got!r}")
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format=fmt, dpi=dpi)

@@ -1,0 +1,6 @@
+"""Automatic segmentation of calibration sessions into rotation and static windows."""
+
+from ._result import Segmentation, describe_found
+from ._segment import segment
+
+__all__ = ["Segmentation", "describe_found", "segment"]

@@ -1,0 +1,102 @@
+"""The versioned calibration file: round trips, units, and refusal of malformed files."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from gyrocal.calibration import Calibration, from_document, load_calibration, save_calibration, to_document
+from gyrocal.errors import FileFormatError
+from gyrocal.models import Affine, ScaleBias
+
+
+def scale_bias_cal(rng) -> Calibration:
+    model = ScaleBias(rng.uniform(0.8, 1.2, 3), rng.uniform(-0.1, 0.1, 3))
+    a = rng.normal(size=(6, 6)) * 1e-4
+    return Calibration(model, "deg/s", "deg/s", method="first-moment", covariance=a @ a.T,
+                       noise_std=np.full(3, 0.035), windows=({"start": 0, "stop": 10, "kind": "rotation"},))
+
+
+def affine_cal(rng) -> Calibration:
+    model = Affine(np.eye(3) + rng.uniform(-0.05, 0.05, (3, 3)), rng.uniform(-0.1, 0.1, 3))
+    return Calibration(model, "counts", "deg/s", sensitivity=131.0, method="thermal")
+
+
+@pytest.mark.parametrize("make", [scale_bias_cal, affine_cal], ids=["scale-bias", "affine"])
+def test_save_load_round_trip(make, rng, tmp_path):
+    cal = make(rng)
+    path = tmp_path / "cal.json"
+    save_calibration(cal, path)
+    back = load_calibration(path)
+    assert type(back.model) is type(cal.model)
+    np.testing.assert_array_equal(back.model.params, cal.model.params)
+    assert (back.input_units, back.output_units, back.sensitivity, back.method) == (
+        cal.input_units, cal.output_units, cal.sensitivity, cal.method)
+    if cal.covariance is None:
+        assert back.covariance is None
+    else:
+        np.testing.assert_array_equal(back.covariance, cal.covariance)
+    assert back.windows == cal.windows
+    raw = rng.normal(0, 100, (20, 3))
+    np.testing.assert_allclose(back.apply(raw), cal.apply(raw), rtol=1e-14)
+
+
+def test_units_are_applied_at_the_edges(rng):
+    cal = scale_bias_cal(rng)
+    raw_deg = rng.normal(0, 50, (5, 3))
+    want = cal.model.correct(np.deg2rad(raw_deg))  # internal rad/s
+    np.testing.assert_allclose(cal.apply(raw_deg), np.rad2deg(want), rtol=1e-13)
+    doc = to_document(cal)
+    assert doc["units"] == {"input": "deg/s", "output": "deg/s", "sensitivity": None, "internal": "rad/s"}
+    assert set(doc["std"]) == {"kx", "ky", "kz", "bx", "by", "bz"}
+
+
+def write(tmp_path, doc) -> str:
+    p = tmp_path / "bad.json"
+    p.write_text(json.dumps(doc))
+    return str(p)
+
+
+@pytest.mark.parametrize(
+    "edit, field",
+    [
+        (lambda d: d.update(version=99), "version"),
+        (lambda d: d.update(format="imucal"), "format"),
+        (lambda d: d.update(model="quadratic"), "model"),
+        (lambda d: d["parameters"]["seed000"].pop("k"), "parameters.seed000.k"),
+        (lambda d: d["parameters"]["seed000"].update(k=[1, 2]), "parameters.seed000.k"),
+        (lambda d: d["parameters"]["seed000"].update(k=[1, -1, 1]), "parameters"),
+        (lambda d: d["units"].update(input="furlongs"), "units"),
+        (lambda d: d["correction"].update(offset=[9, 9, 9]), "correction"),
+        (lambda d: d.update(covariance=[[1.0]]), "covariance"),
+        (lambda d: d.pop("units"), "units.input"),
+    ],
+)
+def test_malformed_files_name_the_field(rng, tmp_path, edit, field):
+    doc = to_document(scale_bias_cal(rng))
+    edit(doc)
+    with pytest.raises(FileFormatError, match=f"'{field.split('.')[0]}") as info:
+        load_calibration(write(tmp_path, doc))
+    assert info.value.field == field
+
+
+def test_non_json_and_missing_files(tmp_path):
+    p = tmp_path / "x.json"
+    p.write_text("{not json")
+    with pytest.raises(FileFormatError, match="not valid JSON"):
+        load_calibration(p)
+    with pytest.raises(FileFormatError, match="no such file"):
+        load_calibration(tmp_path / "missing.json")
+    with pytest.raises(FileFormatError, match="top level"):
+        from_document([], "x")  # type: ignore[arg-type]
+
+
+def test_file_records_version_and_units(rng, tmp_path):
+    path = tmp_path / "c.json"
+    save_calibration(affine_cal(rng), path)
+    doc = json.loads(path.read_text())
+    assert doc["format"] == "gyrocal.calibration" and doc["version"] == 1
+    assert doc["units"]["internal"] == "rad/s" and doc["units"]["sensitivity"] == 131.0
+    assert doc["parameters"]["seed001"]["kg_names"][3] == "Kyx"
+    assert not math.isnan(doc["correction"]["matrix"][0][0])

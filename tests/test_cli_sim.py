@@ -1,0 +1,107 @@
+"""The ``simulate``, ``noise``, ``plan`` and ``study`` commands, in-process and once as a subprocess."""
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+pytest.importorskip("typer")
+
+from gyrocal import load_calibration  # noqa: E402
+from gyrocal.io import read_recording  # noqa: E402
+from gyrocal.noise import load_noise  # noqa: E402
+from test_cli_calibrate import invoke, refused  # noqa: E402  (one in-process runner for every CLI test)
+
+
+def test_simulated_recording_travels_the_calibration_path(tmp_path):
+    rec = tmp_path / "rec.csv"
+    code, out, err = invoke("simulate", "-o", rec, "--k", "1.02,0.97,1.01", "--b", "0.03,-0.02,0.01",
+                            "--noise", "0.02", "--seed", "4")
+    assert code == 0, err
+    truth = json.loads((tmp_path / "rec.truth.json").read_text())
+    assert truth["format"] == "gyrocal.simulation-truth" and truth["k"] == [1.02, 0.97, 1.01]
+    assert len(truth["windows"]) >= 6
+    code, out, err = invoke("calibrate", rec, "--units", "deg/s", "-o", tmp_path / "cal.json")
+    assert code == 0, err
+    cal = load_calibration(tmp_path / "cal.json")
+    err_k = cal.model.k - np.array(truth["k"])
+    err_b = cal.model.b - np.array(truth["b"])
+    std = cal.std
+    assert np.all(np.abs(np.concatenate([err_k, err_b])) < 4 * std), (err_k, err_b, std)
+
+
+def test_simulate_turntable_and_profile(tmp_path):
+    code, _, err = invoke("simulate", "-o", tmp_path / "tt.csv", "--protocol", "turntable", "--sample-rate", "5")
+    assert code == 0, err
+    rec = read_recording(tmp_path / "tt.csv", units="deg/s")
+    assert rec.temp is not None and rec.table_rate is not None and set(rec.axis) == {"x", "y", "z"}
+    prof = tmp_path / "profile.csv"
+    prof.write_text("t,wx,wy,wz\n0,0,0,0\n10,1,0,0\n")
+    code, _, err = invoke("simulate", "-o", tmp_path / "p.csv", "--protocol", "profile", "--profile", prof,
+                          "--duration", "10", "--noise", "0", "--units", "rad/s")
+    assert code == 0, err
+    rec = read_recording(tmp_path / "p.csv", units="rad/s")
+    np.testing.assert_allclose(rec.gyro[:, 0], rec.t / 10, atol=1e-12)  # k = 1, b = 0, no noise
+    assert "--profile" in refused("simulate", "-o", tmp_path / "q.csv", "--protocol", "profile")
+
+
+def test_noise_command_writes_json_and_plot(tmp_path, rng):
+    static = tmp_path / "static.csv"
+    m = rng.standard_normal((30000, 3)) * 0.01
+    np.savetxt(static, np.column_stack([np.arange(30000) / 100.0, m]), delimiter=",", header="t,gx,gy,gz",
+               comments="")
+    code, out, err = invoke("noise", static, "--units", "rad/s", "--json", tmp_path / "n.json", "--plot",
+                            tmp_path / "a.png")
+    assert code == 0, err
+    report = load_noise(tmp_path / "n.json")
+    # ARW at short tau from 30,000 samples: relative sd well below 1 %
+    np.testing.assert_allclose(report.arw, 0.01 / math.sqrt(100.0), rtol=0.03)
+    assert (tmp_path / "a.png").stat().st_size > 0
+    assert "--units" in refused("noise", static)
+    code, out, err = invoke("plan", "--noise-density", tmp_path / "n.json", "--sample-rate", "100")
+    assert code == 0 and "as given" in out, err
+
+
+def test_plan_prints_prediction_and_suggestion():
+    code, out, err = invoke("plan", "--speed", "60", "--noise", "0.035", "--target-scale", "5e-4",
+                            "--target-bias", "0.03deg/s")
+    assert code == 0, err
+    assert "as given" in out and "suggested" in out
+    assert "--target-bias" in refused("plan", "--target-bias", "fast")
+    assert "not both" in refused("plan", "--noise", "0.1", "--noise-density", "0.001")
+
+
+def test_study_command_with_progress(tmp_path):
+    code, out, err = invoke("study", "servo-convergence", "-o", tmp_path, "--reps", "5")
+    assert code == 0, err
+    assert (tmp_path / "convergence.md").exists() and "wrote" in out
+    assert "servo-speed" in refused("study", "servo-normal", "-o", tmp_path, "--methods", "lm")
+    assert "--gyros" in refused("study", "servo-normal", "-o", tmp_path, "--gyros", "0")
+
+
+def test_installed_entry_point_runs_a_study(tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "gyrocal", "study", "servo-normal", "-o", str(tmp_path),
+                           "--gyros", "2", "--reps", "20"], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "errors.png").exists()
+
+
+def test_profile_from_callable_and_from_table(rng):
+    from gyrocal.errors import InputError
+    from gyrocal.models import ScaleBias
+    from gyrocal.simulation import VirtualGyro
+    from gyrocal.simulation.profiles import simulate_profile
+
+    gyro = VirtualGyro(ScaleBias([2.0, 1.0, 1.0], [0.1, 0.0, 0.0]))  # m = w / k - b, noise-free
+    rec, w = simulate_profile(gyro, lambda t: np.column_stack([np.sin(t), 0 * t, 0 * t]), duration=2.0,
+                              sample_rate=50.0, rng=rng)
+    np.testing.assert_allclose(rec.gyro[:, 0], np.sin(rec.t) / 2 - 0.1, atol=1e-12)
+    rec, w = simulate_profile(gyro, (np.array([0.0, 4.0]), np.array([[0, 0, 0], [0, 4.0, 0]])), duration=2.0,
+                              sample_rate=10.0, rng=rng, temp=25.0)
+    np.testing.assert_allclose(w[:, 1], rec.t)
+    assert np.all(rec.temp == 25.0)
+    with pytest.raises(InputError, match="covers"):
+        simulate_profile(gyro, (np.array([0.0, 1.0]), np.zeros((2, 3))), duration=2.0, rng=rng)

@@ -1,0 +1,162 @@
+"""The temperature table: units, file round trip, compensation, smoothing of temperature, smooth model."""
+
+import json
+
+import numpy as np
+import pytest
+
+from gyrocal.errors import FileFormatError, InputError, OutOfRangeError
+from gyrocal.models import correct
+from gyrocal.recording import Recording
+from gyrocal.simulation.thermal_truth import ThermalTruth
+from gyrocal.thermal import (
+    ThermalCalibration,
+    ThermalRangeWarning,
+    fit_smooth,
+    load_thermal,
+    save_thermal,
+    smooth_temperature,
+)
+from gyrocal.thermal.model import kg_to_kb
+
+TEMPS = np.array([-40.0, -30, -20, -10, 0, 10, 20, 30, 40, 50])
+TRUTH = ThermalTruth()
+
+
+def _cal(**kw) -> ThermalCalibration:
+    kg = TRUTH.kg(TEMPS)
+    return ThermalCalibration(temps=TEMPS, kg=kg, smooth=fit_smooth(TEMPS, kg, 3), **kw)
+
+
+def test_user_units_and_canonical_correction_agree_with_internal(rng):
+    cal = _cal(input_units="deg/s", output_units="deg/s")
+    true = rng.uniform(-5, 5, (20, 3))  # rad/s
+    K, B = kg_to_kb(cal.kg[3])
+    raw_deg = np.degrees(true @ K.T + B)
+    matrix, offset = cal.correction
+    np.testing.assert_allclose(correct(matrix[3], offset[3], raw_deg), np.degrees(true), rtol=1e-12, atol=1e-9)
+    Ku, Bu = kg_to_kb(cal.kg_user[3])
+    np.testing.assert_allclose(np.degrees(true) @ Ku.T + Bu, raw_deg, rtol=1e-12, atol=1e-9)
+
+
+def test_file_round_trip(tmp_path):
+    cal = _cal(input_units="deg/s", output_units="rad/s", std=np.full((10, 12), 1e-5), reference_temp=20.0)
+    save_thermal(cal, tmp_path / "t.json")
+    back = load_thermal(tmp_path / "t.json")
+    np.testing.assert_array_equal(back.kg, cal.kg)
+    np.testing.assert_array_equal(back.smooth.coefs, cal.smooth.coefs)
+    assert (back.input_units, back.output_units, back.reference_temp, back.range) == ("deg/s", "rad/s", 20.0, (-40, 50))
+    doc = json.loads((tmp_path / "t.json").read_text())
+    assert doc["format"] == "gyrocal.thermal" and doc["version"] == 1
+    assert doc["kg_names"][:4] == ["Kxx", "Kyy", "Kzz", "Kyx"]
+    np.testing.assert_allclose(doc["points"][0]["kg_user"], cal.kg_user[0])
+
+
+@pytest.mark.parametrize(("field", "value", "match"), [
+    ("version", 7, "version"), ("format", "gyrocal.calibration", "format"), ("kg_names", ["a"], "kg_names")])
+def test_bad_file_names_the_field(tmp_path, field, value, match):
+    save_thermal(_cal(), tmp_path / "t.json")
+    doc = json.loads((tmp_path / "t.json").read_text())
+    doc[field] = value
+    (tmp_path / "t.json").write_text(json.dumps(doc))
+    with pytest.raises(FileFormatError, match=match):
+        load_thermal(tmp_path / "t.json")
+
+
+def test_bad_smooth_model_in_file_is_refused(tmp_path):
+    save_thermal(_cal(), tmp_path / "t.json")
+    doc = json.loads((tmp_path / "t.json").read_text())
+    doc["smooth"]["orders"] = [9] * 12
+    (tmp_path / "t.json").write_text(json.dumps(doc))
+    with pytest.raises(FileFormatError, match="orders"):
+        load_thermal(tmp_path / "t.json")
+
+
+def test_bad_point_in_file_is_named(tmp_path):
+    save_thermal(_cal(), tmp_path / "t.json")
+    doc = json.loads((tmp_path / "t.json").read_text())
+    doc["points"][2]["kg"] = [1.0] * 11
+    (tmp_path / "t.json").write_text(json.dumps(doc))
+    with pytest.raises(FileFormatError, match=r"points\[2\]\.kg"):
+        load_thermal(tmp_path / "t.json")
+
+
+def _recording(true_rates, temp, truth_temp=None, fs=100.0):
+    ideal = TRUTH.gyro(0.0).ideal(true_rates, truth_temp if truth_temp is not None else temp)
+    return Recording(t=np.arange(len(ideal)) / fs, gyro=ideal, temp=temp, sample_rate=fs)
+
+
+def test_apply_recovers_true_rates_at_calibrated_and_between_temperatures():
+    cal = _cal(output_units="deg/s")
+    n = 400
+    true = np.tile(np.radians([[100.0, -50.0, 10.0]]), (n, 1))
+    for temp in (-40.0, 25.0, 47.0):
+        out = cal.apply(_recording(true, np.full(n, temp)))
+        # cubic bias between nodes: Lagrange error stays far below 1e-3 deg/s here
+        np.testing.assert_allclose(out, np.degrees(true), atol=2e-3)
+
+
+def test_apply_without_temp_is_an_error():
+    rec = Recording(t=np.arange(10) / 10.0, gyro=np.zeros((10, 3)))
+    with pytest.raises(InputError, match="no 'temp' column"):
+        _cal().apply(rec)
+
+
+def test_apply_out_of_range_policies():
+    cal = _cal()
+    rec = _recording(np.zeros((50, 3)), np.full(50, 55.0))
+    with pytest.raises(OutOfRangeError, match="55"):
+        cal.apply(rec)
+    for policy in ("clamp", "extrapolate"):
+        with pytest.warns(ThermalRangeWarning):
+            cal.apply(rec, out_of_range=policy)
+    with pytest.warns(ThermalRangeWarning):
+        cal.apply(rec, model="smooth", out_of_range="clamp")
+
+
+def test_quantised_temperature_does_not_make_the_output_jump():
+    cal = _cal()
+    fs, n = 100.0, 30_000  # 300 s
+    true_temp = np.linspace(24.2, 25.8, n)  # a slow drift across the 25 degC reading boundary
+    read = np.round(true_temp)  # 1 degC quantisation
+    true = np.tile(np.radians([[400.0, 0.0, 0.0]]), (n, 1))
+    rec = _recording(true, read, truth_temp=true_temp, fs=fs)
+    jumpy = cal.apply(rec, temp_tau=0.0)
+    smooth = cal.apply(rec)
+    step = np.max(np.abs(np.diff(jumpy, axis=0)))
+    noise = np.radians(0.05)  # a typical per-sample noise
+    assert step > noise / 10  # without smoothing the 1 degC step shows
+    assert np.max(np.abs(np.diff(smooth, axis=0))) < noise / 100
+
+
+def test_temperature_smoothing_keeps_constants_and_has_no_lag():
+    x = np.full(1000, 21.5)
+    np.testing.assert_allclose(smooth_temperature(x, 100.0, 5.0), x)
+    ramp = np.linspace(0, 10, 20_000)
+    y = smooth_temperature(ramp, 100.0, 5.0)
+    # zero phase: the middle of a ramp is not delayed
+    assert abs(y[10_000] - ramp[10_000]) < 1e-6
+    with pytest.raises(InputError, match="temp_tau"):
+        smooth_temperature(x, 100.0, -1.0)
+
+
+def test_smooth_orders_chosen_by_loto(rng):
+    t = TEMPS
+    u = (t - t.mean()) / 45
+    values = np.stack([2 + 0 * t, 1 + 3 * u, 1 + u - 2 * u ** 3], axis=1)
+    values = values + rng.normal(scale=1e-6, size=values.shape)
+    sm = fit_smooth(t, values, max_order=5)
+    assert sm.orders.tolist() == [0, 1, 3]
+    np.testing.assert_allclose(sm(t), values, atol=5e-6)
+
+
+def test_smooth_model_needs_three_points():
+    with pytest.raises(InputError, match=">= 3 temperature points"):
+        fit_smooth([0.0, 10.0], np.zeros((2, 12)))
+
+
+def test_singular_k_is_refused():
+    kg = TRUTH.kg(TEMPS)
+    kg[4, :9] = 0.0
+    with pytest.raises(InputError, match="0 degC is singular"):
+        ThermalCalibration(temps=TEMPS, kg=kg, smooth=fit_smooth(TEMPS, TRUTH.kg(TEMPS)))

@@ -1,0 +1,108 @@
+#!/usr/bin/env python3
+"""Regenerate the bundled example recording ``src/gyrocal/data/example_servo.csv``.
+
+The gyro is the MPU9250 of seed 000, Table III (k = 1.0069, 0.9960, 0.9955;
+b = 0.0442, -0.0089, 0.0076 rad/s) with the paper's simulated white noise
+(0.035 rad/s per sample), read at 200 Hz and quantised to the MPU9250's
++-250 deg/s range (131 LSB per deg/s). The motion is seed 000's protocol (Fig. 1):
+360 deg clockwise and counter-clockwise about x, y and z at 60 deg/s, 3 s apart,
+with 0.3 s speed ramps, 5 % servo vibration and a 5 deg mounting misalignment.
+
+Usage::
+
+    python tools/make_example.py            # writes the CSV and its truth sidecar
+    python tools/make_example.py --check    # regenerates in memory and compares
+
+The sidecar ``example_servo.truth.json`` holds the true parameters, the mounting
+rotation and the true windows. The run is seeded, so the output is reproducible.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from gyrocal import ScaleBias
+from gyrocal.simulation import VirtualGyro
+from gyrocal.simulation.servo import ServoProtocol, simulate_servo
+
+SEED = 20260522
+SAMPLE_RATE = 200.0  # Hz
+K = (1.0069, 0.9960, 0.9955)  # seed 000, Table III, MPU9250
+B = (0.0442, -0.0089, 0.0076)  # rad/s, same table
+NOISE_STD = 0.035  # rad/s per sample, seed 000's simulation setting
+LSB_PER_DPS = 131.0  # MPU9250 at +-250 deg/s
+FULL_SCALE_DPS = 250.0
+DATA = Path(__file__).resolve().parents[1] / "src" / "gyrocal" / "data"
+
+
+def example_setup() -> tuple[VirtualGyro, ServoProtocol, float]:
+    """The gyro, the protocol and the sample rate [Hz] of the bundled example."""
+    gyro = VirtualGyro(
+        model=ScaleBias(k=K, b=B),
+        noise_std=NOISE_STD,
+        quantum=math.radians(1.0 / LSB_PER_DPS),
+        full_scale=math.radians(FULL_SCALE_DPS),
+    )
+    protocol = ServoProtocol(speed=math.radians(60.0), wait=3.0, ramp=0.3, vibration=0.05, misalignment_deg=5.0)
+    return gyro, protocol, SAMPLE_RATE
+
+
+def csv_text(rec) -> str:
+    """The recording as CSV text in deg/s (5 decimals: far below the 2 deg/s noise)."""
+    g = np.degrees(rec.gyro)
+    rows = "\n".join(f"{t:.3f},{x:.5f},{y:.5f},{z:.5f}" for t, (x, y, z) in zip(rec.t, g))
+    return "t,gx,gy,gz\n" + rows + "\n"
+
+
+def truth_doc(truth, protocol: ServoProtocol) -> dict:
+    return {
+        "format": "gyrocal.example-truth",
+        "version": 1,
+        "description": "Simulated MPU9250 (seed 000 Table III) on seed 000's servo protocol; "
+                       "regenerate with tools/make_example.py",
+        "seed": SEED,
+        "sample_rate": SAMPLE_RATE,
+        "units": {"csv": "deg/s", "k": "1", "b": "rad/s", "noise_std": "rad/s"},
+        "k": list(K),
+        "b": list(B),
+        "noise_std": NOISE_STD,
+        "quantum_deg_s": 1.0 / LSB_PER_DPS,
+        "protocol": {"speed_deg_s": 60.0, "turns": list(protocol.turns), "wait_s": protocol.wait,
+                     "ramp_s": protocol.ramp, "vibration": protocol.vibration,
+                     "misalignment_deg": protocol.misalignment_deg},
+        "mounting": np.asarray(truth.mounting).tolist(),
+        "windows": [w.to_dict() for w in truth.windows],
+        "plateaus": [w.to_dict() for w in truth.plateaus],
+    }
+
+
+def generate() -> tuple[str, str]:
+    gyro, protocol, fs = example_setup()
+    rec, truth = simulate_servo(gyro, protocol, sample_rate=fs, rng=np.random.default_rng(SEED))
+    return csv_text(rec), json.dumps(truth_doc(truth, protocol), indent=2) + "\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--check", action="store_true", help="compare with the bundled files instead of writing")
+    args = parser.parse_args(argv)
+    csv, truth = generate()
+    paths = (DATA / "example_servo.csv", DATA / "example_servo.truth.json")
+    if args.check:
+        same = all(p.read_text() == text for p, text in zip(paths, (csv, truth)))
+        print("bundled example is up to date" if same else "bundled example differs; rerun without --check")
+        return 0 if same else 1
+    for path, text in zip(paths, (csv, truth)):
+        path.write_text(text)
+        print(f"wrote {path} ({path.stat().st_size / 1e6:.2f} MB)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
