@@ -1,7 +1,6 @@
 """The ``calibrate``, ``segments``, ``apply`` and ``export`` commands, in-process and once as a subprocess.
 
-In-process runs go through :func:`gyrocal.cli.app.run` (the real error boundary) inside
-typer's ``CliRunner`` isolation, so stdout, stderr and the exit code are what a user sees.
+In-process runs use :mod:`cli_runner` (the real error boundary inside typer's isolation).
 """
 
 import json
@@ -15,34 +14,12 @@ import pytest
 
 pytest.importorskip("typer")
 
-from typer.testing import CliRunner
-
 from gyrocal import ScaleBias, load_calibration
-from gyrocal.cli.app import run
+from cli_runner import invoke, refused  # noqa: E402
 from gyrocal.simulation import VirtualGyro, noise_std_from_density
 from gyrocal.simulation.servo import ServoProtocol, simulate_servo
 
 TRUE = ScaleBias(k=[1.0069, 0.9960, 0.9955], b=[0.0442, -0.0089, 0.0076])
-
-
-def invoke(*args) -> tuple[int, str, str]:
-    """Run the CLI in-process; return (exit code, stdout, stderr)."""
-    runner = CliRunner()
-    with runner.isolation(env={"COLUMNS": "120"}) as (out, err, _):
-        code = run([str(a) for a in args])
-        sys.stdout.flush()
-        sys.stderr.flush()
-        return code, out.getvalue().decode(), err.getvalue().decode()
-
-
-def refused(*args) -> str:
-    """Assert the one-line refusal contract and return the line."""
-    code, out, err = invoke(*args)
-    assert code == 2, (out, err)
-    assert "Traceback" not in out + err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error:"), err
-    return lines[0]
 
 
 def _simulate(rng, protocol, fs=200.0, noise=0.01):

@@ -19,6 +19,7 @@ __all__ = [
     "SegmentationError",
     "MissingDependencyError",
     "OutOfRangeError",
+    "GyrocalWarning",
 ]
 
 
@@ -88,3 +89,7 @@ class MissingDependencyError(GyrocalError, ImportError):
 
 class OutOfRangeError(GyrocalError):
     """A temperature lies outside the calibrated range and no extrapolation was allowed."""
+
+
+class GyrocalWarning(UserWarning):
+    """Base class of the warnings gyrocal issues (the command line prints them as one line each)."""

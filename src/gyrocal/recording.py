@@ -46,7 +46,7 @@ class Recording:
     extra : dict of str to ndarray
         Other columns, passed through unchanged by ``apply``.
     sensitivity : float or None
-        LSB per ``source_units`` rate unit, when raw counts were converted.
+        LSB per output rate unit, when raw counts were converted to rad/s.
     """
 
     t: np.ndarray

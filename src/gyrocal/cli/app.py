@@ -11,6 +11,7 @@ import sys
 try:
     import typer
     from rich.console import Console
+    from rich.markup import escape
 except ImportError:  # pragma: no cover - exercised only without the extra
     sys.stderr.write("gyrocal: the command line needs its extra: pip install 'gyrocal[cli]'\n")
     raise SystemExit(2)
@@ -36,14 +37,19 @@ def _root(debug: bool = typer.Option(False, "--debug", help="Show tracebacks ins
 
 def fail(message: str) -> "typer.Exit":
     """Print one line to stderr and return the exit to raise (code 2)."""
-    err_console.print(f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True)
+    err_console.print(f"[bold red]error:[/] {escape(message)}", highlight=False, soft_wrap=True)
     return typer.Exit(code=2)
 
 
+def _is_usage_error(exc: BaseException) -> bool:
+    # Click's exceptions (bundled inside typer, or the click package with older typer).
+    return hasattr(exc, "format_message") and hasattr(exc, "exit_code")
+
+
 def run(argv: list[str] | None = None) -> int:
-    """Run the CLI; map library and OS errors to exit code 2 with one line."""
+    """Run the CLI; map library, OS and usage errors to one line and exit code 2."""
     try:
-        app(args=argv, standalone_mode=False)
+        rv = app(args=argv, standalone_mode=False)
     except (GyrocalError, OSError) as exc:
         if _state["debug"]:
             raise
@@ -54,11 +60,10 @@ def run(argv: list[str] | None = None) -> int:
     except typer.Abort:
         err_console.print("aborted")
         return 1
-    except Exception as exc:  # click usage errors
-        import click
-
-        if isinstance(exc, click.ClickException):
-            exc.show()
-            return 2
-        raise
-    return 0
+    except Exception as exc:
+        if not _is_usage_error(exc) or _state["debug"]:
+            raise
+        fail(f"{exc.format_message()} (see 'gyrocal --help')")
+        return 2
+    # Without standalone mode, typer returns the code of a raised Exit instead of raising it.
+    return rv if isinstance(rv, int) else 0

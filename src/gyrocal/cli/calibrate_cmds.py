@@ -21,7 +21,7 @@ import numpy as np
 import typer
 
 from ..calibration import Calibration, to_document
-from ..errors import InputError
+from ..errors import GyrocalError, InputError
 from ..segmentation import describe_found
 from ..units import from_rad_s, parse_input_unit, parse_rate_unit, unit_factor
 from ..windows import Window
@@ -125,6 +125,17 @@ def _noise_to_internal(noise_std: float | None, units: str, rate_unit: str, sens
     if units != "counts":
         return noise_std * unit_factor(units)
     return noise_std if sensitivity is None else noise_std / sensitivity * unit_factor(rate_unit)
+
+
+def _density_to_internal(noise_density: str, noise_std: float | None, rec):
+    """--noise-density (rad/s/sqrt(Hz), per axis) as per-sample noise [rad/s] at the recording's rate."""
+    from ..noise import noise_density_arg
+
+    if noise_std is not None:
+        raise InputError("give --noise-std or --noise-density, not both")
+    if rec.units == "counts":
+        raise InputError("--noise-density needs physical units; give --sensitivity with --units counts")
+    return noise_density_arg(noise_density) * math.sqrt(rec.sample_rate)
 
 
 def _windows_from_file(path: Path | None, rec):
@@ -240,6 +251,9 @@ def calibrate(
     method: Annotated[MethodName, typer.Option("--method", help="Estimator.")] = MethodName.first_moment,
     noise_std: Annotated[float | None, typer.Option(
         "--noise-std", help="Per-sample noise, in the data's unit, instead of the one measured.")] = None,
+    noise_density: Annotated[str | None, typer.Option(
+        "--noise-density", help="Noise density instead of the one measured: a number [rad/s/sqrt(Hz)], "
+        "'N deg/s/rtHz', or a noise JSON from 'gyrocal noise --json'.")] = None,
     output: Output = None,
     plot: PlotPath = None,
     force: Force = False,
@@ -268,6 +282,8 @@ def calibrate(
     rec = _read(recording, units, columns, sample_rate, sensitivity, output_units, topic, saturation, no_unit_check)
     win = _windows_from_file(windows, rec)
     noise = _noise_to_internal(noise_std, units, rate_unit, sensitivity)
+    if noise_density is not None:
+        noise = _density_to_internal(noise_density, noise_std, rec)
     run = run_calibration(rec, speed=speed_rad, angle=angle_rad, method=method.value, windows=win, noise_std=noise,
                           output_units=rate_unit)
     cal = run.calibration
@@ -332,7 +348,8 @@ def segments(
     else:
         from ..segmentation import segment
 
-        seg = segment(rec, reference=reference, speed=speed_rad, angle=angle_rad or 2 * math.pi)
+        # Show what was found even when it is not enough to calibrate; warn after the table.
+        seg = segment(rec, reference=reference, speed=speed_rad, angle=angle_rad or 2 * math.pi, require=False)
         found, ignored, source = list(seg.windows), list(seg.ignored), "detected"
     disp = "counts" if rec.units == "counts" else rate_unit
     console.print(f"{len(found)} windows {source} in {recording.name} ({len(rec)} samples, {rec.sample_rate:.4g} Hz)",
@@ -357,6 +374,11 @@ def segments(
         console.print(skipped)
     else:
         console.print("nothing ignored")
+    if given is None:
+        try:
+            seg.require()
+        except GyrocalError as exc:
+            err_console.print(f"[yellow]warning:[/] {escape(str(exc))}", highlight=False)
     if plot is not None:
         from ..plotting._mpl import save_figure
         from ..plotting.calibration import calibration_figure

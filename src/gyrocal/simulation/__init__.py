@@ -1,5 +1,22 @@
-"""Simulation: a virtual gyro and the motions of both papers' protocols."""
+"""Simulation: a virtual gyro and the motions of both papers' protocols.
 
+Readings from :func:`simulate_servo`, :func:`simulate_turntable` and
+:func:`simulate_profile` are :class:`~gyrocal.recording.Recording` objects, so simulated
+and real data travel one path. :func:`paper_observations` (per sample) and
+:func:`simulate_observations` (exact fast path) draw seed 000's window statistics.
+"""
+
+from .fast import simulate_observations
 from .gyro import ThermalErrors, VirtualGyro, noise_std_from_density
+from .profiles import simulate_profile
+from .servo import ServoProtocol, simulate_servo
+from .thermal_truth import ThermalTruth
+from .turntable import TurntableProtocol, simulate_turntable
+from .windows import paper_observations
 
-__all__ = ["VirtualGyro", "ThermalErrors", "noise_std_from_density"]
+__all__ = [
+    "VirtualGyro", "ThermalErrors", "noise_std_from_density",
+    "ServoProtocol", "simulate_servo",
+    "ThermalTruth", "TurntableProtocol", "simulate_turntable",
+    "simulate_profile", "paper_observations", "simulate_observations",
+]

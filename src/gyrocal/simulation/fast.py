@@ -32,10 +32,9 @@ from typing import Sequence
 
 import numpy as np
 
-from .._validation import finite_array, positive
 from ..errors import InputError
 from ..observations import ObservationSet
-from .windows import PAPER_AXES, _tilted_axes, axis_vector, paper_observations
+from .windows import PAPER_AXES, _tilted_axes, axis_vector, check_protocol_args, paper_observations
 
 __all__ = ["window_statistics", "noise_var_dof", "simulate_observations"]
 
@@ -147,17 +146,7 @@ def simulate_observations(
     if not fast:
         return paper_observations(k, b, speed=speed, sample_rate=sample_rate, noise_std=noise_std, jitter=jitter,
                                   misalignment=misalignment, static_duration=static_duration, axes=axes, rng=rng)
-    k = np.atleast_2d(finite_array("k", k, shape_tail=(3,)))
-    b = np.atleast_2d(finite_array("b", b, shape_tail=(3,)))
-    if k.ndim != 2 or k.shape != b.shape:
-        raise InputError(f"k and b must both have shape (B, 3), got {k.shape} and {b.shape}")
-    if np.any(k <= 0):
-        raise InputError("k must be > 0 for every gyro and axis")
-    speed = positive("speed", speed)
-    fs = positive("sample_rate", sample_rate)
-    sd = np.broadcast_to(finite_array("noise_std", noise_std), (3,))
-    if np.any(sd < 0) or not (jitter >= 0 and misalignment >= 0 and static_duration >= 0):
-        raise InputError("noise_std, jitter, misalignment and static_duration must be >= 0")
+    k, b, speed, fs, sd = check_protocol_args(k, b, speed, sample_rate, noise_std, jitter, misalignment, static_duration)
     n_rot = int(round(2 * np.pi / speed * fs))
     n_sta = int(round(static_duration * fs))
     if n_rot < 3 or (static_duration > 0 and n_sta < 3):

@@ -55,6 +55,26 @@ def _tilted_axes(e: np.ndarray, misalignment: float, size: int, rng: np.random.G
     return np.cos(tilt) * e + np.sin(tilt) * (np.cos(phi) * p1 + np.sin(phi) * p2)
 
 
+def check_protocol_args(k, b, speed, sample_rate, noise_std, jitter, misalignment, static_duration):
+    """Validate the protocol arguments shared by the per-sample and fast generators.
+
+    Returns ``k, b`` as (B, 3) arrays, ``speed`` [rad/s], ``sample_rate`` [Hz] and
+    ``noise_std`` as (3,) [rad/s].
+    """
+    k = np.atleast_2d(finite_array("k", k, shape_tail=(3,)))
+    b = np.atleast_2d(finite_array("b", b, shape_tail=(3,)))
+    if k.ndim != 2 or k.shape != b.shape:
+        raise InputError(f"k and b must both have shape (B, 3), got {k.shape} and {b.shape}")
+    if np.any(k <= 0):
+        raise InputError("k must be > 0 for every gyro and axis")
+    speed = positive("speed", speed)
+    fs = positive("sample_rate", sample_rate)
+    sd = np.broadcast_to(finite_array("noise_std", noise_std), (3,))
+    if np.any(sd < 0) or not (jitter >= 0 and misalignment >= 0 and static_duration >= 0):
+        raise InputError("noise_std, jitter, misalignment and static_duration must be >= 0")
+    return k, b, speed, fs, sd
+
+
 def _reduce(m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Window mean, mean of squares and first-difference noise variance of (B, n, 3) readings."""
     d = np.diff(m, axis=1)
@@ -103,17 +123,7 @@ def paper_observations(
         Batched (B, n_windows, 3); rotation windows carry ``rate = speed``, each followed
         by its static window when ``static_duration > 0``.
     """
-    k = np.atleast_2d(finite_array("k", k, shape_tail=(3,)))
-    b = np.atleast_2d(finite_array("b", b, shape_tail=(3,)))
-    if k.ndim != 2 or k.shape != b.shape:
-        raise InputError(f"k and b must both have shape (B, 3), got {k.shape} and {b.shape}")
-    if np.any(k <= 0):
-        raise InputError("k must be > 0 for every gyro and axis")
-    speed = positive("speed", speed)
-    fs = positive("sample_rate", sample_rate)
-    sd = np.broadcast_to(finite_array("noise_std", noise_std), (3,))
-    if np.any(sd < 0) or not (jitter >= 0 and misalignment >= 0 and static_duration >= 0):
-        raise InputError("noise_std, jitter, misalignment and static_duration must be >= 0")
+    k, b, speed, fs, sd = check_protocol_args(k, b, speed, sample_rate, noise_std, jitter, misalignment, static_duration)
     e_axes = [axis_vector(a) for a in axes]
     n_rot = round(2 * np.pi / speed * fs)
     n_sta = round(static_duration * fs)

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+from ..errors import GyrocalWarning
+
 __all__ = ["DroppedStepsWarning", "SaturatedStepsWarning", "ThermalRangeWarning", "ThermalWarning"]
 
 
-class ThermalWarning(UserWarning):
+class ThermalWarning(GyrocalWarning):
     """Base class of the warnings the thermal method issues."""
 
 
