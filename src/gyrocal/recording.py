@@ -14,14 +14,18 @@ __all__ = ["Recording"]
 
 
 def _readonly(arr: np.ndarray) -> np.ndarray:
-    arr = np.array(arr)
-    arr.setflags(write=False)
-    return arr
+    # A read-only view, not a copy: copying 10-million-sample logs costs more than parsing them.
+    view = np.asarray(arr).view()
+    view.setflags(write=False)
+    return view
 
 
 @dataclass(frozen=True)
 class Recording:
     """Samples of one gyro, in gyrocal's internal units.
+
+    The arrays are read-only views of what was passed in (no copy is made), so a
+    caller should not modify its own arrays after building a recording.
 
     Attributes
     ----------
