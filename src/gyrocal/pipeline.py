@@ -143,7 +143,9 @@ def _given_windows(rec: Recording, windows: Sequence[Window], reference: str, sp
 
 
 def _observe(gyro: np.ndarray, fs: float, w: Window, reference: str, speed) -> Observation:
-    samples = gyro[w.start:w.stop]
+    # Column-major windows make the per-axis reductions contiguous (about 4x faster than C order);
+    # copying only the windows used is cheaper than converting the whole log.
+    samples = np.asfortranarray(gyro[w.start:w.stop])
     if w.kind == "static":
         return observe(samples, fs, "static")
     if reference == "speed":
@@ -208,9 +210,7 @@ def calibrate(
     uses_static = method == "first-moment"
     seg.require(static_allowed=uses_static, min_rotations=0 if uses_static else 6)
     used = seg.windows if uses_static else seg.rotations
-    # Column-major readings make each window's per-axis means contiguous (about 4x faster on long logs).
-    gyro = np.asfortranarray(rec.gyro)
-    observations = tuple(_observe(gyro, rec.sample_rate, w, reference, value) for w in used)
+    observations = tuple(_observe(rec.gyro, rec.sample_rate, w, reference, value) for w in used)
     fit = estimator.fit(ObservationSet.from_observations(observations))
     cal = Calibration(
         model=fit.model,
