@@ -71,8 +71,9 @@ class Recording:
         t = finite_array("t", self.t, ndim=1)
         if t.shape != (n,):
             raise InputError(f"t has {len(t)} samples but gyro has {n}")
-        if n >= 2 and np.any(np.diff(t) <= 0):
-            i = int(np.argmax(np.diff(t) <= 0))
+        steps_ok = t[1:] > t[:-1]
+        if not steps_ok.all():
+            i = int(np.argmin(steps_ok))
             raise InputError(f"time does not increase at sample {i + 1} (t={t[i]} then {t[i + 1]}); sort or deduplicate the log")
         if self.units not in ("rad/s", "counts"):
             raise InputError(f"units must be 'rad/s' or 'counts' inside gyrocal, got {self.units!r}")

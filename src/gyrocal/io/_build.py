@@ -99,15 +99,19 @@ def _check_saturation(raw, full_scale, policy: str, source: str) -> np.ndarray |
 
 
 def _rates_block(gx, gy, gz) -> np.ndarray:
-    """(N, 3) rates: the reader's own block when gx, gy, gz are its columns, else a new copy."""
+    """Column-major (N, 3) rates: the transpose of the reader's own (3, N) block when gx, gy, gz
+    are its rows, else a new copy.
+
+    Column-major keeps every per-axis pass (checks, segmentation, window means) contiguous.
+    """
     base = gx.base
     if (
-        isinstance(base, np.ndarray) and base.ndim == 2 and base.shape == (len(gx), 3) and base.dtype == np.float64
+        isinstance(base, np.ndarray) and base.ndim == 2 and base.shape == (3, len(gx)) and base.dtype == np.float64
         and base.flags.c_contiguous and all(c.base is base for c in (gy, gz))
-        and [c.ctypes.data - base.ctypes.data for c in (gx, gy, gz)] == [0, 8, 16]
+        and [c.ctypes.data - base.ctypes.data for c in (gx, gy, gz)] == [0, 8 * len(gx), 16 * len(gx)]
     ):
-        return base
-    return np.column_stack([gx, gy, gz]).astype(float, copy=False)
+        return base.T
+    return np.stack([gx, gy, gz]).astype(float, copy=False).T
 
 
 def build_recording(

@@ -135,14 +135,15 @@ def _read_arrow(path: Path, h: int, delimiter: str, names: list[str], mapping: d
     rates = [mapping[c] for c in ("gx", "gy", "gz")]
     cols = {}
     if all(pa.types.is_float64(table.column(n).type) for n in rates):
-        # fill one (N, 3) block chunk by chunk: the recording is built on it without another copy
-        block = np.empty((table.num_rows, 3))
+        # fill one (3, N) block chunk by chunk: the recording is built on its transpose, a
+        # column-major (N, 3) array, without another copy (see _build.rates_block)
+        block = np.empty((3, table.num_rows))
         for j, name in enumerate(rates):
             pos = 0
             for chunk in table.column(name).chunks:
-                block[pos:pos + len(chunk), j] = chunk.to_numpy(zero_copy_only=False)
+                block[j, pos:pos + len(chunk)] = chunk.to_numpy(zero_copy_only=False)
                 pos += len(chunk)
-            cols[name] = block[:, j]
+            cols[name] = block[j]
     return {n: cols[n] if n in cols else table.column(n).to_numpy() for n in names}
 
 

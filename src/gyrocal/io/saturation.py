@@ -76,11 +76,3 @@ def find_saturation(gyro, full_scale: float | None = None, *, min_run: int = MIN
         if runs.any() and level > 2.0 * np.median(np.abs(col)):
             mask[:, j] = runs
     return mask
-    level = np.maximum(np.abs(g.max(axis=0)), np.abs(g.min(axis=0)))  # whole-array passes, not per column
-    stuck = g == level
-    stuck |= g == -level
-    for j in np.flatnonzero((np.count_nonzero(stuck, axis=0) >= min_run) & (level > 0) & np.isfinite(level)):
-        runs = _long_runs(stuck[:, j], int(min_run))
-        if runs.any() and level[j] > 2.0 * np.median(np.abs(g[:, j])):
-            mask[:, j] = runs
-    return mask
