@@ -142,7 +142,7 @@ def test_algorithm1_differs_from_lm_with_twelve_observations(rng):
     """Beyond six, Algorithm 1's fixed point ignores d beta0 / d beta and is not the LS optimum.
 
     Measured at the paper's settings (12 turns: the six, twice): RMS difference ~2e-7 rad/s in
-    b and ~2e-8 in k, about 1e-3 .. 1e-4 of their standard deviations (docs/parts/core.md).
+    b and ~2e-8 in k, about 1e-3 .. 1e-4 of their standard deviations (docs/core.md).
     """
     k, b = truth(rng, 200)
     obs = paper_observations(k, b, speed=SPEED, axes=PAPER_AXES * 2, rng=rng)

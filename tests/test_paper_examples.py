@@ -2,7 +2,7 @@
 
 Each case is simulated 200 times at the paper's normal conditions (200 Hz, 60 deg/s,
 0.035 rad/s, 5 % jitter, tilts up to 0.1 rad). Table I's convergence behaviour is
-checked against the fixed-point analysis in docs/parts/core.md.
+checked against the fixed-point analysis in docs/core.md.
 """
 
 import math
