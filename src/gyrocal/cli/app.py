@@ -14,7 +14,7 @@ try:
     from rich.markup import escape
 except ImportError:  # pragma: no cover - exercised only without the extra
     sys.stderr.write("gyrocal: the command line needs its extra: pip install 'gyrocal[cli]'\n")
-    raise SystemExit(2)
+    raise SystemExit(2) from None
 
 from ..errors import GyrocalError
 
