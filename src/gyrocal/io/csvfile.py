@@ -136,7 +136,7 @@ def _read_arrow(path: Path, h: int, delimiter: str, names: list[str], mapping: d
     cols = {}
     if all(pa.types.is_float64(table.column(n).type) for n in rates):
         # fill one (3, N) block chunk by chunk: the recording is built on its transpose, a
-        # column-major (N, 3) array, without another copy (see _build.rates_block)
+        # column-major (N, 3) array, without another copy (see _build._rates_block)
         block = np.empty((3, table.num_rows))
         for j, name in enumerate(rates):
             pos = 0
