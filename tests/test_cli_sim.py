@@ -105,3 +105,13 @@ def test_profile_from_callable_and_from_table(rng):
     assert np.all(rec.temp == 25.0)
     with pytest.raises(InputError, match="covers"):
         simulate_profile(gyro, (np.array([0.0, 1.0]), np.zeros((2, 3))), duration=2.0, rng=rng)
+
+
+def test_help_keeps_the_units_written_in_brackets():
+    """Help texts give units as [deg/s]; rich markup would swallow them as tags."""
+    code, out, _ = invoke("simulate", "--help")
+    assert code == 0
+    for text in ("[deg/s]", "[rad/s]", "[rad/s/sqrt(s)]"):
+        assert text in out
+    code, out, _ = invoke("calibrate", "--help")
+    assert code == 0 and "[rad/s/sqrt(Hz)]" in out

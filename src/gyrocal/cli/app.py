@@ -24,6 +24,8 @@ app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    rich_markup_mode=None,  # help texts carry units in brackets, e.g. [deg/s]: not markup
+    context_settings={"max_content_width": 100},
 )
 console = Console()
 err_console = Console(stderr=True)
