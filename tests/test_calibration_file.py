@@ -71,6 +71,16 @@ def write(tmp_path, doc) -> str:
         (lambda d: d["correction"].update(offset=[9, 9, 9]), "correction"),
         (lambda d: d.update(covariance=[[1.0]]), "covariance"),
         (lambda d: d.pop("units"), "units.input"),
+        (lambda d: d.update(version=True), "version"),
+        (lambda d: d.update(version=1.0), "version"),
+        (lambda d: d.update(method=None), "method"),
+        (lambda d: d.update(windows=5), "windows"),
+        (lambda d: d.update(windows=[1, 2]), "windows"),
+        (lambda d: d.update(windows=None), "windows"),
+        (lambda d: d["units"].update(sensitivity="x"), "units.sensitivity"),
+        (lambda d: d["units"].update(sensitivity=[1]), "units.sensitivity"),
+        (lambda d: d.update(covariance=(-np.eye(6)).tolist()), "covariance"),
+        (lambda d: d.update(covariance=(np.eye(6) + np.triu(np.ones((6, 6)), 1)).tolist()), "covariance"),
     ],
 )
 def test_malformed_files_name_the_field(rng, tmp_path, edit, field):

@@ -179,6 +179,14 @@ def test_results_are_frozen(rng):
         fit.k[0, 0] = 1.0
     with pytest.raises(ValueError):
         fit.covariance[0, 0, 0] = 1.0
+    one = fit.item(0)
+    for arrays in (fit, one):
+        for name in ("residuals", "history", "noise_std", "covariance"):
+            with pytest.raises(ValueError):
+                getattr(arrays, name).flat[0] = 1.0
+    for name in ("iterations", "converged"):
+        with pytest.raises(ValueError):
+            getattr(fit, name)[0] = 0
 
 
 # --- errors (issue 2, item 5) ---
@@ -225,3 +233,5 @@ def test_non_convergence_reports_iterations(rng):
     assert info.value.iterations == 1
     with pytest.raises(ConvergenceError, match="first-moment least squares did not converge after 1 iterations"):
         FirstMoment(max_iter=1).fit(obs)
+    with pytest.raises(ConvergenceError, match="did not converge after 1 iterations"):
+        PaperLM(max_iter=1).fit(obs)

@@ -20,6 +20,7 @@ def test_observe_reductions(rng):
     assert o.rate == pytest.approx(2 * math.pi / 4.0)  # the sense does not matter to the norm
     assert observe(m, 100.0, "speed", speed=1.5).rate == 1.5
     assert observe(m, 100.0, "static").rate == 0.0
+    assert observe(m, 100.0, "angle").angle == pytest.approx(2 * math.pi)  # one revolution by default
 
 
 def test_observe_refuses_bad_input():
@@ -33,6 +34,13 @@ def test_observe_refuses_bad_input():
         observe(np.zeros((10, 3)), 100.0, "turn")  # type: ignore[arg-type]
     with pytest.raises(InputError, match="sample_rate must be finite and > 0"):
         observe(np.zeros((10, 3)), 0.0, "static")
+    for bad in (math.nan, math.inf):
+        with pytest.raises(NonFiniteInputError, match="sample_rate must be finite"):
+            observe(np.zeros((10, 3)), bad, "static")
+        with pytest.raises(NonFiniteInputError, match="speed must be finite"):
+            observe(np.zeros((10, 3)), 100.0, "speed", speed=bad)
+    with pytest.raises(InputError, match="angle must be a non-zero number"):
+        observe(np.zeros((10, 3)), 100.0, "angle", angle="full")
 
 
 def test_set_stacks_and_takes(rng):

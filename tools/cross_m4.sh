@@ -49,6 +49,14 @@ echo "== code size of the library (calibration, correction, thermal table, accum
 arm-none-eabi-size "$build/gyrocal_cal.o"
 undefined="$(arm-none-eabi-nm -u "$build/gyrocal_cal.o" | tr -s ' \n' ' ')"
 echo "   undefined symbols (must be none): ${undefined:-none}"
+echo "== static RAM of an on-device calibration (the example's accumulator and six observations), bytes:"
+total=0
+while read -r _ size _ name; do
+    case "$name" in obs|obs.*|acc|acc.*)
+        printf '   %-10s %5d\n' "$name" $((16#$size)); total=$((total + 16#$size)) ;;
+    esac
+done < <(arm-none-eabi-nm -S "$build/main.o")
+printf '   total      %5d\n' "$total"
 echo "== whole example image (library, example, start-up):"
 arm-none-eabi-size "$build/example.elf"
 

@@ -38,7 +38,7 @@ def check_header(doc: dict, path, fmt: str, versions: tuple[int, ...]) -> int:
     if got != fmt:
         raise FileFormatError(f"{path}: field 'format' is {got!r}, expected {fmt!r}", "format")
     version = doc.get("version")
-    if version not in versions:
+    if type(version) is not int or version not in versions:  # JSON true == 1 and 1.0 == 1 in Python
         raise FileFormatError(
             f"{path}: field 'version' is {version!r}; this gyrocal reads {', '.join(map(str, versions))}", "version"
         )

@@ -42,6 +42,8 @@ def positive(name: str, value: float) -> float:
         v = float(value)
     except (TypeError, ValueError) as exc:
         raise InputError(f"{name} must be a number, got {value!r}") from exc
-    if not np.isfinite(v) or v <= 0:
+    if not np.isfinite(v):
+        raise NonFiniteInputError(f"{name} must be finite and > 0, got {value!r}")
+    if v <= 0:
         raise InputError(f"{name} must be finite and > 0, got {value!r}")
     return v

@@ -158,6 +158,13 @@ def to_document(cal: Calibration) -> dict[str, Any]:
     }
 
 
+def _is_covariance(cov: np.ndarray) -> bool:
+    """Symmetric and positive semi-definite, to rounding."""
+    scale = max(float(np.abs(cov).max()), np.finfo(float).tiny)
+    return bool(np.allclose(cov, cov.T, rtol=0, atol=1e-12 * scale)
+                and np.linalg.eigvalsh((cov + cov.T) / 2).min() >= -1e-9 * scale)
+
+
 def from_document(doc: dict, path="file") -> Calibration:
     """Validate a document and rebuild the :class:`Calibration`, naming any bad field."""
     if not isinstance(doc, dict):
@@ -178,16 +185,30 @@ def from_document(doc: dict, path="file") -> Calibration:
             raise
         raise FileFormatError(f"{path}: field 'parameters' does not describe a gyro: {exc}", "parameters") from None
     n = len(model.params)
+    input_units, output_units = get(doc, "units.input", path), get(doc, "units.output", path)
+    sensitivity = get(doc, "units.sensitivity", path)
+    if sensitivity is not None and (isinstance(sensitivity, bool) or not isinstance(sensitivity, (int, float))):
+        raise FileFormatError(f"{path}: field 'units.sensitivity' must be a number or null, got {sensitivity!r}",
+                              "units.sensitivity")
+    method = get(doc, "method", path)
+    if not isinstance(method, str):
+        raise FileFormatError(f"{path}: field 'method' must be a string, got {method!r}", "method")
+    covariance = get_array(doc, "covariance", (n, n), path, allow_none=True)
+    if covariance is not None and not _is_covariance(covariance):
+        raise FileFormatError(f"{path}: field 'covariance' must be symmetric positive semi-definite", "covariance")
+    windows = get(doc, "windows", path)
+    if not isinstance(windows, list) or not all(isinstance(w, dict) for w in windows):
+        raise FileFormatError(f"{path}: field 'windows' must be a list of objects", "windows")
     try:
         cal = Calibration(
             model=model,
-            input_units=get(doc, "units.input", path),
-            output_units=get(doc, "units.output", path),
-            sensitivity=get(doc, "units.sensitivity", path),
-            method=str(get(doc, "method", path)),
-            covariance=get_array(doc, "covariance", (n, n), path, allow_none=True),
+            input_units=input_units,
+            output_units=output_units,
+            sensitivity=sensitivity,
+            method=method,
+            covariance=covariance,
             noise_std=get_array(doc, "noise_std", (3,), path, allow_none=True),
-            windows=tuple(get(doc, "windows", path)),
+            windows=tuple(windows),
         )
     except InputError as exc:
         raise FileFormatError(f"{path}: field 'units': {exc}", "units") from None

@@ -178,9 +178,18 @@ def thermal_c_header(tc) -> str:
         "  s = clamp(i - 2, 0, n - 3), i the first node >= T (the same rule as gyrocal.thermal).",
         f"Outside [{lo:g}, {hi:g}] degC the call fails with GYROCAL_E_RANGE unless GYROCAL_THERMAL_CLAMP is passed.",
     ]
+    tau = getattr(tc, "temp_tau", None)
+    if tau:
+        comment += [
+            f"Temperature: gyrocal apply low-passes the temp readings (time constant {tau:g} s) before the lookup,",
+            "  so 1 degC steps do not make the output jump; feed temp_degC through a first-order low-pass",
+            "  with GYROCAL_THERMAL_TEMP_TAU_S on the device too.",
+        ]
     rows = ",\n".join(f"    {_c_vector(row)}" for row in kg)
     body = (
-        f"#define GYROCAL_THERMAL_N {n}\n\n"
+        f"#define GYROCAL_THERMAL_N {n}\n"
+        + (f"#define GYROCAL_THERMAL_TEMP_TAU_S {float(tau)!r}f\n" if tau else "")
+        + "\n"
         + f"static const float GYROCAL_THERMAL_TEMPS[GYROCAL_THERMAL_N] = {_c_vector(temps)};\n\n"
         + f"static const float GYROCAL_THERMAL_KG[GYROCAL_THERMAL_N][12] = {{\n{rows}\n}};\n\n"
         + "static const gyrocal_thermal_t GYROCAL_THERMAL = {GYROCAL_THERMAL_N, GYROCAL_THERMAL_TEMPS, "
@@ -319,7 +328,9 @@ class CLibrary:
             return
         name, cls = _STATUS.get(status, (f"status {status}", GyrocalError))
         message = f"the C library's {what} returned {name}"
-        raise cls(message, iterations) if cls is ConvergenceError else cls(message)
+        if cls is ConvergenceError:
+            raise cls(f"{message}: did not converge after {iterations} iterations", iterations)
+        raise cls(message)
 
     def correct(self, matrix, offset, raw) -> np.ndarray:
         """``gyrocal_correct`` on every row of `raw` (N, 3)."""

@@ -82,9 +82,10 @@ class Observation:
 def _magnitude(name: str, value) -> float:
     """|value|, refusing zero and non-numbers: a turn's sense does not matter to the norm equations."""
     try:
-        return positive(name, abs(float(value)))
+        magnitude = abs(float(value))
     except (TypeError, ValueError):
         raise InputError(f"{name} must be a non-zero number, got {value!r}") from None
+    return positive(name, magnitude)
 
 
 def observe(
@@ -108,7 +109,7 @@ def observe(
     speed : float, optional
         Known rate magnitude [rad/s]; required for ``kind="speed"``.
     angle : float, optional
-        Angle turned inside the window [rad]; required for ``kind="angle"``.
+        Angle turned inside the window [rad] for ``kind="angle"``; default one revolution (2 pi).
     """
     m = finite_array("samples", samples, shape_tail=(3,), ndim=2)
     fs = positive("sample_rate", sample_rate)
@@ -120,9 +121,7 @@ def observe(
             raise InputError("kind='speed' needs speed [rad/s]")
         rate, ang = _magnitude("speed", speed), math.nan
     elif kind == "angle":
-        if angle is None:
-            raise InputError("kind='angle' needs angle [rad]")
-        ang = _magnitude("angle", angle)
+        ang = 2 * math.pi if angle is None else _magnitude("angle", angle)
         rate = ang / duration
     elif kind == "static":
         rate, ang = 0.0, math.nan

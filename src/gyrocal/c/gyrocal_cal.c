@@ -306,6 +306,9 @@ gyrocal_status_t gyrocal_algorithm1(const gyrocal_obs_t obs[GYROCAL_N_OBS], gyro
             return finish_kb(beta, r, out);
         }
     }
+    if (iterations) {
+        *iterations = GYROCAL_MAX_ITER;
+    }
     return GYROCAL_E_NOCONV;
 }
 
@@ -338,6 +341,9 @@ gyrocal_status_t gyrocal_first_moment(const gyrocal_obs_t obs[GYROCAL_N_OBS], gy
             fp += h * h * v[j] - h * v[j + 3];
         }
         if (!(fabsf(fp) > 0.0f)) {
+            if (iterations) {
+                *iterations = it;
+            }
             return GYROCAL_E_NOCONV;
         }
         step = f / fp;
@@ -351,6 +357,9 @@ gyrocal_status_t gyrocal_first_moment(const gyrocal_obs_t obs[GYROCAL_N_OBS], gy
             }
             return finish_kb(beta, r, out);
         }
+    }
+    if (iterations) {
+        *iterations = GYROCAL_MAX_ITER;
     }
     return GYROCAL_E_NOCONV;
 }

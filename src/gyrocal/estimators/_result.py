@@ -14,9 +14,9 @@ __all__ = ["BatchFit", "FitResult", "Method"]
 Method = Literal["first-moment", "algorithm1", "lm"]
 
 
-def _frozen(value) -> np.ndarray:
-    """A read-only float view of `value`: no copy of large batch arrays that are already float."""
-    arr = np.asarray(value, dtype=float).view()
+def _frozen(value, dtype=float) -> np.ndarray:
+    """A read-only view of `value`: no copy of large batch arrays that already have `dtype`."""
+    arr = np.asarray(value, dtype=dtype).view()
     arr.setflags(write=False)
     return arr
 
@@ -65,8 +65,10 @@ class BatchFit:
             if np.shape(self.covariance) != (B, 6, 6):
                 raise ValueError(f"covariance must have shape ({B}, 6, 6)")
             object.__setattr__(self, "covariance", _frozen(self.covariance))
-        object.__setattr__(self, "iterations", np.asarray(self.iterations, dtype=int))
-        object.__setattr__(self, "converged", np.asarray(self.converged, dtype=bool))
+        for name in ("residuals", "history") + (("noise_std",) if self.noise_std is not None else ()):
+            object.__setattr__(self, name, _frozen(getattr(self, name)))
+        object.__setattr__(self, "iterations", _frozen(self.iterations, int))
+        object.__setattr__(self, "converged", _frozen(self.converged, bool))
 
     def __len__(self) -> int:
         return self.k.shape[0]
@@ -128,6 +130,11 @@ class FitResult:
     covariance: np.ndarray | None
     noise_std: np.ndarray | None
     history: np.ndarray
+
+    def __post_init__(self):
+        for name in ("residuals", "covariance", "noise_std", "history"):
+            if getattr(self, name) is not None:
+                object.__setattr__(self, name, _frozen(getattr(self, name)))
 
     @property
     def std(self) -> np.ndarray | None:
