@@ -310,7 +310,8 @@ def test_thermal_matches_python(clib, rng, units):
 
 def test_thermal_out_of_range_refused_or_clamped_like_python(clib, rng):
     tc = thermal_table(rng)
-    temp = np.array([-55.0, -40.5, 50.25, 85.0])
+    lo, hi = tc.range
+    temp = np.array([lo - 15.0, lo - 0.75, hi + 0.6, hi + 35.0])  # beyond the 0.5 degC margin
     raw = rng.normal(0, 50.0, (len(temp), 3))
     for i in range(len(temp)):
         with pytest.raises(OutOfRangeError, match="GYROCAL_E_RANGE"):
@@ -320,6 +321,11 @@ def test_thermal_out_of_range_refused_or_clamped_like_python(clib, rng):
     out = clib.thermal_correct(tc.temps, tc.kg_user, temp, raw, clamp=True)
     edge = np.clip(temp, *tc.range)
     assert np.all(np.abs(out - ref) <= thermal_tolerance(tc, edge, raw, ref))
+    # inside the margin both clamp silently, without being asked
+    near = np.array([lo - 0.4, hi + 0.3])
+    ref = python_thermal(tc, near, raw[:2])
+    out = clib.thermal_correct(tc.temps, tc.kg_user, near, raw[:2])
+    assert np.all(np.abs(out - ref) <= thermal_tolerance(tc, np.clip(near, lo, hi), raw[:2], ref))
 
 
 # -- headers ---------------------------------------------------------------------------------------------------

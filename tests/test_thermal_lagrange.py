@@ -1,5 +1,7 @@
 """3-node Lagrange interpolation (seed 001 eq. 21-22) and its stencil and range rules."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -54,6 +56,17 @@ def test_nodes_are_hit_exactly(rng):
 def test_outside_the_range_is_refused_by_default_naming_the_temperature():
     with pytest.raises(OutOfRangeError, match=r"\[-40, 50\] degC, e.g. -45.00 degC"):
         lagrange_weights(NODES, [0.0, -45.0])
+
+
+def test_readings_within_the_margin_of_an_end_node_count_as_at_it(rng):
+    values = rng.normal(size=(len(NODES), 2))
+    lo, hi = NODES[0], NODES[-1]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        out = interpolate(NODES, values, [lo - 0.4, hi + 0.4])
+    np.testing.assert_allclose(out, values[[0, -1]], atol=1e-13)
+    with pytest.raises(OutOfRangeError, match=r"e.g. 50.60 degC"):
+        interpolate(NODES, values, [hi + 0.6])
 
 
 def test_clamp_warns_and_uses_the_end_value(rng):

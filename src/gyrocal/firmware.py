@@ -176,7 +176,8 @@ def thermal_c_header(tc) -> str:
         "  " + ", ".join(KG_NAMES) + ".",
         "Interpolation (seed 001 eq. 21-22): 3-node Lagrange over nodes s, s+1, s+2 with",
         "  s = clamp(i - 2, 0, n - 3), i the first node >= T (the same rule as gyrocal.thermal).",
-        f"Outside [{lo:g}, {hi:g}] degC the call fails with GYROCAL_E_RANGE unless GYROCAL_THERMAL_CLAMP is passed.",
+        f"More than GYROCAL_THERMAL_MARGIN outside [{lo:g}, {hi:g}] degC the call fails with GYROCAL_E_RANGE",
+        "  unless GYROCAL_THERMAL_CLAMP is passed; closer, the temperature is clamped to the range.",
     ]
     tau = getattr(tc, "temp_tau", None)
     if tau:

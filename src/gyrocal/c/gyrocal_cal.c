@@ -108,7 +108,8 @@ gyrocal_status_t gyrocal_thermal_correct(const gyrocal_thermal_t *table, float t
     n = table->n;
     t = table->temps;
     if (temp < t[0] || temp > t[n - 1]) {
-        if (!(flags & GYROCAL_THERMAL_CLAMP)) {
+        if (!(flags & GYROCAL_THERMAL_CLAMP) && (temp < t[0] - GYROCAL_THERMAL_MARGIN ||
+                                                  temp > t[n - 1] + GYROCAL_THERMAL_MARGIN)) {
             return GYROCAL_E_RANGE;
         }
         temp = temp < t[0] ? t[0] : t[n - 1];

@@ -71,6 +71,9 @@ typedef struct {
 
 /* Flags of gyrocal_thermal_correct. */
 #define GYROCAL_THERMAL_CLAMP 1u /* clamp the temperature to the table instead of failing */
+/* Temperatures this close to the end nodes [degC] are clamped to them without GYROCAL_THERMAL_CLAMP:
+ * a node is the mean of noisy readings (gyrocal.thermal.lagrange.RANGE_MARGIN). */
+#define GYROCAL_THERMAL_MARGIN 0.5f
 
 /* Streaming window accumulator: compensated sums of deviations from the first sample. */
 typedef struct {

@@ -6,7 +6,9 @@ and exit code 2; ``--debug`` shows the traceback instead.
 
 from __future__ import annotations
 
+import contextlib
 import sys
+import warnings
 
 try:
     import typer
@@ -41,6 +43,21 @@ def fail(message: str) -> "typer.Exit":
     """Print one line to stderr and return the exit to raise (code 2)."""
     err_console.print(f"[bold red]error:[/] {escape(message)}", highlight=False, soft_wrap=True)
     return typer.Exit(code=2)
+
+
+def warn(message: str) -> None:
+    """Print one ``warning:`` line to stderr."""
+    err_console.print(f"[yellow]warning:[/] {escape(message)}", highlight=False, soft_wrap=True)
+
+
+@contextlib.contextmanager
+def warnings_as_lines():
+    """Show the library's warnings raised inside the block as one ``warning:`` line each, once."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        yield
+    for message in dict.fromkeys(str(w.message) for w in caught):  # the same warning from two models: once
+        warn(message)
 
 
 def _is_usage_error(exc: BaseException) -> bool:

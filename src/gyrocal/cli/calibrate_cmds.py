@@ -25,7 +25,7 @@ from ..errors import GyrocalError, InputError
 from ..segmentation import describe_found
 from ..units import from_rad_s, parse_input_unit, parse_rate_unit, unit_factor
 from ..windows import Window
-from .app import app, console, err_console
+from .app import app, console, warn, warnings_as_lines
 from .thermal_cmds import OutOfRangePolicy as OutOfRange
 
 EXAMPLE = "example_servo.csv"
@@ -378,7 +378,7 @@ def segments(
         try:
             seg.require()
         except GyrocalError as exc:
-            err_console.print(f"[yellow]warning:[/] {escape(str(exc))}", highlight=False)
+            warn(str(exc))
     if plot is not None:
         from ..plotting._mpl import save_figure
         from ..plotting.calibration import calibration_figure
@@ -441,19 +441,13 @@ def apply(
 
 def _apply_thermal(tc, rec, model: str, out_of_range: str) -> np.ndarray:
     """Thermal correction; its warnings become 'warning:' lines, its advice names the CLI flag."""
-    import warnings
-
     from ..errors import OutOfRangeError
 
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+    with warnings_as_lines():
         try:
-            corrected = tc.apply(rec, model=model, out_of_range=out_of_range)
+            return tc.apply(rec, model=model, out_of_range=out_of_range)
         except OutOfRangeError as exc:
             raise OutOfRangeError(str(exc).replace("out_of_range=", "--out-of-range ")) from None
-    for w in caught:
-        err_console.print(f"warning: {w.message}", highlight=False, markup=False)
-    return corrected
 
 
 @app.command()

@@ -6,8 +6,6 @@ Library warnings (saturated steps, clamped temperatures) are printed as one line
 
 from __future__ import annotations
 
-import contextlib
-import warnings
 from enum import Enum
 from pathlib import Path
 from typing import Annotated
@@ -16,7 +14,7 @@ import numpy as np
 import typer
 
 from ..units import parse_input_unit, parse_rate_unit, unit_factor
-from .app import app, console, err_console, fail
+from .app import app, console, fail, warnings_as_lines
 
 __all__ = ["thermal", "thermal_report"]
 
@@ -38,16 +36,6 @@ FullScale = Annotated[float | None, typer.Option(
     "--full-scale", help="Gyro range in the data's unit; steps with samples at it are left out (with a warning).")]
 TempTol = Annotated[float, typer.Option(
     "--temp-tolerance", help="Spread allowed inside a step, and closest distinct temperature points (degC).")]
-
-
-@contextlib.contextmanager
-def _print_warnings():
-    """Show library warnings as one line each on stderr."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        yield
-    for w in caught:
-        err_console.print(f"[yellow]warning:[/] {w.message}", highlight=False, soft_wrap=True)
 
 
 def _units(units: str, output_units: str | None, sensitivity: float | None) -> tuple[str, str]:
@@ -97,7 +85,7 @@ def thermal(
     from ..thermal import calibrate_thermal, save_thermal
 
     in_u, out_u = _units(units, output_units, sensitivity)
-    with _print_warnings():
+    with warnings_as_lines():
         recs, names = _read(session, units, columns, sample_rate, sensitivity, output_units)
         cal, fit = calibrate_thermal(recs, input_units=in_u, output_units=out_u, settle=settle,
                                      full_scale=_full_scale(full_scale, units, out_u, sensitivity),
@@ -152,7 +140,7 @@ def thermal_report(
 
     cal = load_thermal(calibration)
     units = units or cal.input_units
-    with _print_warnings():
+    with warnings_as_lines():
         recs, _ = _read(test, units, columns, sample_rate, sensitivity, cal.output_units if units == "counts" else None)
         try:
             ev = evaluate(cal, recs, settle=settle, temp_tolerance=temp_tolerance, out_of_range=out_of_range.value,
@@ -164,10 +152,10 @@ def thermal_report(
     from rich.table import Table
 
     table = Table(title=escape(f"RMS error [{cal.output_units}] per rotating axis / gyro axis"))
-    for col in ("rot", "gyro", "uncomp.", "traditional", "lagrange", "smooth", "lagr. vs trad."):
+    for col in ("rot", "gyro", "uncomp.", "traditional", "lagrange", "smooth", "lagrange cut"):
         table.add_column(col, justify="right")
     for r in ev.summary(cal.output_units):
         table.add_row(r["rotating_axis"], r["gyro_axis"], *(f"{r[m + '_rms']:.4g}" for m in
-                      ("uncompensated", "traditional", "lagrange", "smooth")), f"{r['lagrange_vs_traditional_pct']:.1f} %")
+                      ("uncompensated", "traditional", "lagrange", "smooth")), f"{r['lagrange_rms_reduction_pct']:.1f} %")
     console.print(table)
     console.print(f"wrote {len(paths)} files to {output}")

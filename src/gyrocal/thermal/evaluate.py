@@ -57,7 +57,7 @@ class Evaluation:
                     row[f"{m}_mean"] = float(e[sel, j].mean() / f)
                     row[f"{m}_rms"] = float(np.sqrt(np.mean(e[sel, j] ** 2)) / f)
                 t, lg = row["traditional_rms"], row["lagrange_rms"]
-                row["lagrange_vs_traditional_pct"] = float(100 * (t - lg) / t) if t > 0 else 0.0
+                row["lagrange_rms_reduction_pct"] = float(100 * (t - lg) / t) if t > 0 else 0.0
                 rows.append(row)
         return rows
 

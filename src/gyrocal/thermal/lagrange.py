@@ -5,7 +5,10 @@ with nodes ``T_0 < ... < T_{n-1}`` and ``i`` the first node ``>= T``, the stenci
 starts at ``s = clip(i - 2, 0, n - 3)``. Inside ``(T_{i-1}, T_i)`` with ``i >= 2`` that
 is the paper's nodes ``i-2, i-1, i``; the paper is silent on the first interval
 ``[T_0, T_1]``, which we serve with nodes 0, 1, 2 (the only stencil that stays
-inside the table). Outside ``[T_0, T_{n-1}]`` the caller chooses what happens.
+inside the table). Readings within :data:`RANGE_MARGIN` of the end nodes are
+clamped to them silently: a node's temperature is the mean of noisy or quantised
+readings, so a test at the same set point reads a few tenths beyond it. Further
+outside ``[T_0, T_{n-1}]`` the caller chooses what happens.
 """
 
 from __future__ import annotations
@@ -19,10 +22,13 @@ from .._validation import finite_array
 from ..errors import InputError, OutOfRangeError
 from ._warn import ThermalRangeWarning
 
-__all__ = ["OutOfRange", "check_nodes", "interpolate", "lagrange_weights", "range_policy", "stencil"]
+__all__ = ["OutOfRange", "RANGE_MARGIN", "check_nodes", "interpolate", "lagrange_weights", "range_policy", "stencil"]
 
 OutOfRange = Literal["refuse", "clamp", "extrapolate"]
 _POLICIES = ("refuse", "clamp", "extrapolate")
+
+#: Readings this close to the end nodes [degC] count as at them (GYROCAL_THERMAL_MARGIN in C).
+RANGE_MARGIN = 0.5
 
 
 def check_nodes(nodes) -> np.ndarray:
@@ -39,16 +45,18 @@ def range_policy(nodes: np.ndarray, temp: np.ndarray, out_of_range: OutOfRange) 
     if out_of_range not in _POLICIES:
         raise InputError(f"out_of_range={out_of_range!r} is not one of {', '.join(_POLICIES)}")
     lo, hi = nodes[0], nodes[-1]
-    outside = (temp < lo) | (temp > hi)
+    outside = (temp < lo - RANGE_MARGIN) | (temp > hi + RANGE_MARGIN)
     if not outside.any():
-        return temp
+        return np.clip(temp, lo, hi)
     worst = float(temp[outside][np.argmax(np.abs(temp[outside] - (lo + hi) / 2))])
-    where = f"{int(outside.sum())} sample(s) outside the calibrated range [{lo:g}, {hi:g}] degC, e.g. {worst:.2f} degC"
+    where = f"{int(outside.sum())} temperature reading(s) outside the calibrated range [{lo:g}, {hi:g}] degC, e.g. {worst:.2f} degC"
     if out_of_range == "refuse":
         raise OutOfRangeError(f"{where}; pass out_of_range='clamp' or 'extrapolate' to accept them")
     warnings.warn(f"{where}; {'clamped to the nearest end' if out_of_range == 'clamp' else 'extrapolated'}",
                   ThermalRangeWarning, stacklevel=3)
-    return np.clip(temp, lo, hi) if out_of_range == "clamp" else temp
+    if out_of_range == "clamp":
+        return np.clip(temp, lo, hi)
+    return np.where(outside, temp, np.clip(temp, lo, hi))
 
 
 def stencil(nodes: np.ndarray, temp: np.ndarray) -> np.ndarray:

@@ -62,7 +62,7 @@ def write_report(cal: ThermalCalibration, evaluation: Evaluation, out_dir: str |
         if rows:
             _write_rows(out / name, rows)
             written.append(out / name)
-    rms_cols = ["rotating_axis", "gyro_axis"] + [f"{m}_rms" for m in METHODS] + ["lagrange_vs_traditional_pct"]
+    rms_cols = ["rotating_axis", "gyro_axis"] + [f"{m}_rms" for m in METHODS] + ["lagrange_rms_reduction_pct"]
     mean_cols = ["rotating_axis", "gyro_axis"] + [f"{m}_mean" for m in METHODS]
     lo, hi = cal.range
     text = [
