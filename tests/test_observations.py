@@ -106,3 +106,22 @@ def test_paper_observations_refuses_bad_input(rng):
         paper_observations([[1, 1, 1]], [[0, 0, 0]], speed=0.0, rng=rng)
     with pytest.raises(NonFiniteInputError):
         paper_observations([[1, np.nan, 1]], [[0, 0, 0]], speed=1.0, rng=rng)
+
+
+def test_sample_times_weight_a_window_with_gaps(rng):
+    m = rng.normal(0.5, 0.1, (400, 3))
+    t = np.arange(400) / 100.0
+    even = observe(m, 100.0, "angle", angle=2 * math.pi)
+    timed = observe(m, 100.0, "angle", angle=2 * math.pi, t=t)
+    np.testing.assert_allclose(timed.mean, even.mean, rtol=1e-12)
+    assert timed.duration == pytest.approx(4.0)
+    # drop every other sample of the second half, which turns faster: those left stand for twice the time
+    m[200:] += 1.0
+    keep = np.r_[np.arange(200), np.arange(200, 400, 2)]
+    gappy = observe(m[keep], 100.0, "angle", angle=2 * math.pi, t=t[keep])
+    assert gappy.duration == pytest.approx(3.98 + (0.01 + 0.02) / 2)  # span plus half a step at each end
+    # each half of the time counts alike, however many samples it kept
+    np.testing.assert_allclose(gappy.mean, (m[:200].mean(0) + m[200:400:2].mean(0)) / 2, atol=2e-3)
+    assert np.all(gappy.mean - m[keep].mean(0) > 0.15)  # a plain sample mean would read 1/6 too low
+    with pytest.raises(InputError, match="t has 3 sample times"):
+        observe(m, 100.0, "angle", t=t[:3])

@@ -104,6 +104,25 @@ def test_windows_override_detection(rng):
     assert own.observations[1].angle == math.pi and own.fit.model.k[0] < 0.6
 
 
+def test_a_log_that_dropped_samples_uses_its_time_column(rng):
+    rec, _ = simulate_servo(GYRO, ServoProtocol.hand(wait=(6.0, 4.0)), sample_rate=FS, rng=rng)
+    keep = np.sort(rng.choice(len(rec), size=int(0.97 * len(rec)), replace=False))  # 3 % lost at random
+    dropped = Recording(t=rec.t[keep], gyro=rec.gyro[keep], sample_rate=FS)
+    run = calibrate(dropped, angle=2 * math.pi)
+    # a turn's time comes from t, not from its sample count (that would read k 3 % high: ~40 sigma)
+    _within_4_sigma(run)
+
+
+def test_speed_reference_refuses_given_windows_with_ramps(rng):
+    rec, truth = simulate_servo(GYRO, PROTOCOLS["paper"], sample_rate=FS, rng=rng)
+    statics = [Window(w.start, w.stop, "static") for w in truth.windows if w.kind == "static"]
+    whole = [Window(w.start, w.stop, w.kind, label=w.label) for w in truth.windows if w.kind == "rotation"]
+    with pytest.raises(InputError, match=r"rotation window 0 \(\+x\) is not at constant speed: .* trim them, or use"):
+        calibrate(rec, speed=SPEED, windows=whole + statics)
+    plateaus = [Window(w.start, w.stop, "rotation", label=w.label) for w in truth.plateaus]
+    _within_4_sigma(calibrate(rec, speed=SPEED, windows=plateaus + statics))
+
+
 def test_windows_file_needs_an_angle_for_rotations_without_one(rng):
     rec, _ = simulate_servo(GYRO, PROTOCOLS["paper"], sample_rate=FS, rng=rng)
     with pytest.raises(InputError, match="ends after the recording"):

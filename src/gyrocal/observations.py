@@ -88,6 +88,19 @@ def _magnitude(name: str, value) -> float:
     return positive(name, magnitude)
 
 
+def _time_weights(t: np.ndarray, n: int) -> np.ndarray:
+    """Time each sample stands for [s]: half of each neighbouring step (the whole step at the ends)."""
+    if t.shape != (n,):
+        raise InputError(f"t has {len(t)} sample times but the window has {n} samples")
+    step = np.diff(t)
+    if np.any(step <= 0):
+        raise InputError("t must increase strictly inside a window")
+    w = np.empty(n)
+    w[0], w[-1] = step[0], step[-1]
+    w[1:-1] = (step[:-1] + step[1:]) / 2
+    return w
+
+
 def observe(
     samples,
     sample_rate: float,
@@ -95,6 +108,7 @@ def observe(
     *,
     speed: float | None = None,
     angle: float | None = None,
+    t=None,
 ) -> Observation:
     """Reduce a window of readings to an :class:`Observation`.
 
@@ -110,12 +124,21 @@ def observe(
         Known rate magnitude [rad/s]; required for ``kind="speed"``.
     angle : float, optional
         Angle turned inside the window [rad] for ``kind="angle"``; default one revolution (2 pi).
+    t : array_like, shape (n,), optional
+        Sample times [s] of a log with gaps (dropped samples). The means are then weighted
+        by the time each sample stands for, and the duration is the time spanned, so an
+        angle reference still gives ``angle = mean rate x duration``. Without it the
+        samples are taken as evenly spaced at `sample_rate`.
     """
     m = finite_array("samples", samples, shape_tail=(3,), ndim=2)
     fs = positive("sample_rate", sample_rate)
     if len(m) < 2:
         raise InputError(f"a window needs at least 2 samples, got {len(m)}")
-    duration = len(m) / fs
+    if t is None:
+        weights, duration = None, len(m) / fs
+    else:
+        weights = _time_weights(finite_array("t", t, ndim=1), len(m))
+        duration = float(weights.sum())
     if kind == "speed":
         if speed is None:
             raise InputError("kind='speed' needs speed [rad/s]")
@@ -129,8 +152,8 @@ def observe(
         raise InputError(f"kind={kind!r} is not one of {_KINDS}")
     d = np.diff(m, axis=0)
     return Observation(
-        mean=m.mean(axis=0),
-        mean_sq=(m * m).mean(axis=0),
+        mean=np.average(m, axis=0, weights=weights),
+        mean_sq=np.average(m * m, axis=0, weights=weights),
         noise_var=(d * d).mean(axis=0) / 2.0,
         count=len(m),
         duration=duration,

@@ -108,6 +108,23 @@ def _baseline(rec: Recording, windows: Sequence[Window]) -> np.ndarray:
     return static_level(rec.gyro, max(8, int(round(0.25 * rec.sample_rate))))[0]
 
 
+#: A given window's first or last tenth may turn this much slower than its middle (--speed only).
+_SPEED_SPREAD = 0.1
+
+
+def _require_constant_speed(samples: np.ndarray, w: Window, i: int) -> None:
+    """Refuse a window with ramps: the speed reference holds only on the constant-speed part."""
+    tenths = np.linalg.norm([part.mean(axis=0) for part in np.array_split(samples, 10)], axis=1)
+    middle = float(np.median(tenths))
+    worst = float(min(tenths[0], tenths[-1]))
+    if worst < (1 - _SPEED_SPREAD) * middle:
+        raise InputError(
+            f"rotation window {i} ({w.label or f'{w.start}:{w.stop}'}) is not at constant speed: an end of it turns "
+            f"at {100 * worst / middle:.0f} % of its middle (a ramp); with a known speed the windows must cover only "
+            "the constant-speed part: trim them, or use the angle reference (--angle) with whole turns"
+        )
+
+
 def _given_windows(rec: Recording, windows: Sequence[Window], reference: str, speed, angle) -> Segmentation:
     """A :class:`Segmentation` from user windows: axis and sense filled in, references attached."""
     windows = list(windows)
@@ -130,6 +147,7 @@ def _given_windows(rec: Recording, windows: Sequence[Window], reference: str, sp
             j = int(np.abs(v).argmax())
             w = dataclasses.replace(w, axis="xyz"[j], sign=1 if v[j] >= 0 else -1)
         if reference == "speed":
+            _require_constant_speed(rec.gyro[w.start:w.stop] - base, w, i)
             w = dataclasses.replace(w, angle=speed * len(w) / fs, rate=speed)
         else:
             a = w.angle if math.isfinite(w.angle) else angle
@@ -142,15 +160,24 @@ def _given_windows(rec: Recording, windows: Sequence[Window], reference: str, sp
     return Segmentation(tuple(out), (), "file", fs, base, noise)
 
 
-def _observe(gyro: np.ndarray, fs: float, w: Window, reference: str, speed) -> Observation:
+def _gap_times(rec: Recording, w: Window) -> np.ndarray | None:
+    """The window's sample times when the log dropped samples inside it, else None (evenly spaced)."""
+    if not rec.has_time or len(w) < 2:
+        return None
+    t = rec.t[w.start:w.stop]
+    return t if (t[-1] - t[0]) * rec.sample_rate > len(w) - 0.5 else None
+
+
+def _observe(rec: Recording, w: Window, reference: str, speed) -> Observation:
     # Column-major windows make the per-axis reductions contiguous (about 4x faster than C order);
     # copying only the windows used is cheaper than converting the whole log.
-    samples = np.asfortranarray(gyro[w.start:w.stop])
+    samples = np.asfortranarray(rec.gyro[w.start:w.stop])
+    fs = rec.sample_rate
     if w.kind == "static":
         return observe(samples, fs, "static")
     if reference == "speed":
         return observe(samples, fs, "speed", speed=speed)
-    return observe(samples, fs, "angle", angle=w.angle)
+    return observe(samples, fs, "angle", angle=w.angle, t=_gap_times(rec, w))
 
 
 def calibrate(
@@ -210,7 +237,7 @@ def calibrate(
     uses_static = method == "first-moment"
     seg.require(static_allowed=uses_static, min_rotations=0 if uses_static else 6)
     used = seg.windows if uses_static else seg.rotations
-    observations = tuple(_observe(rec.gyro, rec.sample_rate, w, reference, value) for w in used)
+    observations = tuple(_observe(rec, w, reference, value) for w in used)
     fit = estimator.fit(ObservationSet.from_observations(observations))
     cal = Calibration(
         model=fit.model,
@@ -220,6 +247,6 @@ def calibrate(
         method=method,
         covariance=fit.covariance,
         noise_std=fit.noise_std,
-        windows=tuple(w.to_dict() for w in used),
+        windows=tuple({**w.to_dict(), "rate": o.rate} for w, o in zip(used, observations)),
     )
     return CalibrationRun(cal, fit, seg, observations, reference, value)
