@@ -76,8 +76,10 @@ def test_paper_methods_are_selectable(servo_csv, tmp_path, method):
     assert code == 0, err
     cal = load_calibration(out)
     assert cal.method == method and stdout.startswith(f"{method}, speed 60 deg/s")
-    # the paper's estimators report no covariance, so this is only a coarse 1 % sanity bound
-    assert cal.std is None and np.allclose(cal.model.k, TRUE.k, atol=0.01)
+    # their 1-sigma is the spread; their mean-of-squares bias comes on top and is printed:
+    # about 3e-3 of k here (1.7e-3 from noise, 1.25e-3 from the 5 % servo vibration)
+    assert cal.std is not None and "reads k low by about" in stdout
+    assert np.all(np.abs(cal.model.params - TRUE.params) < 4 * cal.std + np.r_[0.004 * TRUE.k, 0, 0, 0])
 
 
 def test_ground_station_log_without_time_column(rng, tmp_path):

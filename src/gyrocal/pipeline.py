@@ -75,6 +75,17 @@ class CalibrationRun:
             rows.append((f"b{axis}", p[3 + j] / c, std[3 + j] / c, cal.input_units))
         return rows
 
+    def scale_bias_note(self) -> str | None:
+        """For the paper's mean-of-squares methods, how low they read k (SPEC); None otherwise."""
+        fit = self.fit
+        if self.calibration.method == "first-moment" or fit.noise_std is None:
+            return None
+        rates = np.array([o.rate for o in self.observations if o.kind != "static"])
+        # noise power in each window's mean of squares: |k (m + b)|^2 grows by sum_j k_j^2 s_j^2
+        low = float(np.mean(np.sum(fit.model.k**2 * fit.noise_std**2) / (2 * rates**2)))
+        return (f"{self.calibration.method} reads k low by about {low:.2g} (the noise power in its mean of squares); "
+                "its 1-sigma is the spread only; method first-moment is unbiased")
+
     def report(self) -> str:
         """Plain-text summary: parameters in user units with 1-sigma, and the correction."""
         cal = self.calibration
@@ -96,8 +107,8 @@ class CalibrationRun:
         if cal.noise_std is not None:
             noise = cal.noise_std / cal.input_scale
             lines.append(f"  noise std per sample [{cal.input_units}]: " + "  ".join(f"{v:.3g}" for v in noise))
-        if cal.std is None:
-            lines.append(f"  {cal.method} gives no covariance; use method first-moment for uncertainties")
+        if (note := self.scale_bias_note()) is not None:
+            lines.append("  note: " + note)
         return "\n".join(lines)
 
 

@@ -215,8 +215,8 @@ def _print_calibration(run, truth: Calibration | None = None) -> None:
         noise = cal.noise_std / cal.input_scale
         console.print(f"per-sample noise behind the 1-sigma: {', '.join(f'{v:.3g}' for v in noise)} {cal.input_units}",
                       highlight=False)
-    if cal.std is None:
-        console.print(f"{cal.method} gives no covariance; use --method first-moment for uncertainties")
+    if (note := run.scale_bias_note()) is not None:
+        console.print("note: " + note.replace("method first-moment", "--method first-moment"), highlight=False)
     n_rot = sum(w.get("kind") == "rotation" for w in cal.windows)
     console.print(f"windows used: {n_rot} rotation, {len(cal.windows) - n_rot} static; found: "
                   f"{describe_found(run.segmentation.windows, run.segmentation.ignored)}", highlight=False)

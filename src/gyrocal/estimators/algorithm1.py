@@ -9,7 +9,7 @@ import numpy as np
 from ..observations import ObservationSet
 from ._checks import require_converged, require_positive_k2
 from ._result import BatchFit, FitResult
-from .paper_model import beta_to_kb, gamma, kb_history, regressors
+from .paper_model import beta_to_kb, gamma, kb_covariance, kb_history, regressors
 
 __all__ = ["Algorithm1", "algorithm1_batch"]
 
@@ -56,9 +56,10 @@ def algorithm1_batch(obs: ObservationSet, *, tol: float = 1e-6, max_iter: int = 
     require_converged(~active, iterations, "Algorithm 1")
     k, b = beta_to_kb(beta, "Algorithm 1")
     residuals = (X @ beta[..., None])[..., 0] + gamma(beta)[:, None] - Y
+    cov, nv = kb_covariance(beta, obs)
     return BatchFit(
         method="algorithm1", k=k, b=b, iterations=iterations, converged=~active, residuals=residuals,
-        covariance=None, noise_std=None, history=kb_history(np.stack(history)).transpose(1, 0, 2),
+        covariance=cov, noise_std=np.sqrt(nv), history=kb_history(np.stack(history)).transpose(1, 0, 2),
     )
 
 

@@ -10,7 +10,7 @@ from ..observations import ObservationSet
 from ._checks import require_converged
 from ._lm import batched_lm
 from ._result import BatchFit, FitResult
-from .paper_model import beta_to_kb, gamma, kb_history, regressors
+from .paper_model import beta_to_kb, gamma, gamma_gradient, kb_covariance, kb_history, regressors
 
 __all__ = ["PaperLM", "paper_lm_batch"]
 
@@ -26,15 +26,15 @@ def paper_lm_batch(obs: ObservationSet, *, max_iter: int = 100) -> BatchFit:
     def fun(beta):
         with np.errstate(divide="ignore", invalid="ignore"):
             r = np.einsum("bni,bi->bn", X, beta) + gamma(beta)[:, None] - Y
-            dg = np.concatenate([-beta[:, 3:] ** 2 / (4 * beta[:, :3] ** 2), beta[:, 3:] / (2 * beta[:, :3])], axis=1)
-        return r, X + dg[:, None, :]
+            return r, X + gamma_gradient(beta)[:, None, :]
 
     beta, iterations, converged, residuals, history = batched_lm(fun, beta0, max_iter=max_iter)
     require_converged(converged, iterations, "Levenberg-Marquardt")
     k, b = beta_to_kb(beta, "Levenberg-Marquardt")
+    cov, nv = kb_covariance(beta, obs)
     return BatchFit(
         method="lm", k=k, b=b, iterations=iterations, converged=converged, residuals=residuals,
-        covariance=None, noise_std=None, history=kb_history(history),
+        covariance=cov, noise_std=np.sqrt(nv), history=kb_history(history),
     )
 
 

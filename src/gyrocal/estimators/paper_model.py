@@ -10,6 +10,7 @@ import numpy as np
 
 from ..observations import ObservationSet
 from ._checks import require_count, require_every_axis, require_full_rank, require_positive_k2
+from ._noise import pooled_noise_var
 
 BETA_NAMES = ("beta1", "beta2", "beta3", "beta4", "beta5", "beta6")
 
@@ -40,3 +41,35 @@ def kb_history(beta_history: np.ndarray) -> np.ndarray:
     b1 = beta_history[..., :3]
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.concatenate([np.sqrt(b1), beta_history[..., 3:] / (2.0 * b1)], axis=-1)
+
+
+def gamma_gradient(beta: np.ndarray) -> np.ndarray:
+    """``d beta0 / d beta`` (B, 6)."""
+    return np.concatenate([-beta[:, 3:] ** 2 / (4 * beta[:, :3] ** 2), beta[:, 3:] / (2 * beta[:, :3])], axis=1)
+
+
+def kb_covariance(beta: np.ndarray, obs: ObservationSet) -> tuple[np.ndarray, np.ndarray]:
+    """Covariance (B, 6, 6) of ``(k, b)`` from the regression, and the noise variance (B, 3) used.
+
+    White noise of variance ``s_j^2`` per sample moves a window's ``mean m_j`` by
+    ``s_j^2 / n`` and its ``mean m_j^2`` by ``(4 mu_j^2 s_j^2 + 2 s_j^4) / n``, the two
+    correlated by ``2 mu_j s_j^2 / n``. A row ``beta0 + x . beta - y`` therefore has variance
+    ``sum_j s_j^2 ((2 beta_j mu_j + beta_{j+3})^2 + 2 beta_j^2 s_j^2) / n``. The least-squares
+    sandwich gives the covariance of ``beta``, and the delta method that of ``(k, b)``. It is
+    the spread over noise draws; the bias of the mean-of-squares form (SPEC) comes on top.
+    """
+    obs = obs.as_batch()
+    nv = pooled_noise_var(obs.mean.transpose(1, 2, 0), obs.noise_var.transpose(1, 2, 0), obs.count, obs.static).T
+    b1, b2 = beta[:, None, :3], beta[:, None, 3:]
+    s2 = nv[:, None, :]
+    row_var = np.sum(s2 * ((2 * b1 * obs.mean + b2) ** 2 + 2 * b1**2 * s2), axis=-1) / obs.count
+    J = np.concatenate([obs.mean_sq, obs.mean], axis=-1) + gamma_gradient(beta)[:, None, :]
+    Hinv = np.linalg.inv(np.einsum("bmi,bmj->bij", J, J))
+    cov_beta = Hinv @ np.einsum("bmi,bm,bmj->bij", J, row_var, J) @ Hinv
+    # k = sqrt(beta_1..3), b = beta_4..6 / (2 beta_1..3)
+    G = np.zeros_like(cov_beta)
+    j = np.arange(3)
+    G[:, j, j] = 1 / (2 * np.sqrt(beta[:, :3]))
+    G[:, j + 3, j] = -beta[:, 3:] / (2 * beta[:, :3] ** 2)
+    G[:, j + 3, j + 3] = 1 / (2 * beta[:, :3])
+    return G @ cov_beta @ G.transpose(0, 2, 1), nv
