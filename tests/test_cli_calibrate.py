@@ -351,3 +351,46 @@ def test_apply_and_export_a_thermal_file(thermal_file, tmp_path):
     assert yaml.safe_load((tmp_path / "t.yaml").read_text())["format"] == "gyrocal.thermal"
     assert invoke("export", path, "--format", "c-header", "-o", tmp_path / "t.h")[0] == 0
     assert "#" in (tmp_path / "t.h").read_text()
+
+
+def test_outputs_never_destroy_an_input_or_another_file(servo_csv, tmp_path):
+    path, _ = servo_csv
+    cal = tmp_path / "cal.json"
+    assert invoke("calibrate", path, "--units", "deg/s", "--speed", "60", "-o", cal)[0] == 0
+    before = Path(path).read_text()
+    assert "also an input" in refused("apply", cal, path, "-o", path, "--force")
+    assert "also an input" in refused("calibrate", path, "--units", "deg/s", "--speed", "60", "-o", path, "--force")
+    assert Path(path).read_text() == before
+    # an earlier apply output may be replaced; a file gyrocal did not write needs --force
+    corrected = tmp_path / "corrected.csv"
+    assert invoke("apply", cal, path, "-o", corrected)[0] == 0
+    assert invoke("apply", cal, path, "-o", corrected)[0] == 0
+    notes = tmp_path / "notes.csv"
+    notes.write_text("my notes\n")
+    assert "--force" in refused("apply", cal, path, "-o", notes)
+    assert notes.read_text() == "my notes\n"
+    # export: the same text again is fine, something else needs --force
+    header = tmp_path / "cal.h"
+    assert invoke("export", cal, "--format", "c-header", "-o", header)[0] == 0
+    assert invoke("export", cal, "--format", "c-header", "-o", header)[0] == 0
+    assert "--force" in refused("export", cal, "--format", "json", "-o", header)
+    assert invoke("export", cal, "--format", "json", "-o", header, "--force")[0] == 0
+
+
+def test_an_output_under_a_file_is_refused_before_anything_is_written(servo_csv, tmp_path):
+    path, _ = servo_csv
+    (tmp_path / "afile").write_text("x")
+    line = refused("calibrate", path, "--units", "deg/s", "--speed", "60", "-o", tmp_path / "afile" / "c.json",
+                   "--plot", tmp_path / "p.png")
+    assert "is a file, not a folder" in line
+    assert not (tmp_path / "p.png").exists()
+
+
+def test_a_closed_stdout_does_not_cost_the_outputs(tmp_path):
+    out, plot = tmp_path / "cal.json", tmp_path / "cal.png"
+    proc = subprocess.Popen([sys.executable, "-m", "gyrocal", "calibrate", "--example", "-o", str(out), "--plot", str(plot)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()  # like '| head -0'
+    _, err = proc.communicate(timeout=120)
+    assert b"Traceback" not in err
+    assert load_calibration(out).method == "first-moment" and plot.stat().st_size > 0

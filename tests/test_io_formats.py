@@ -13,7 +13,7 @@ def test_parquet_round_trip(tmp_path, rng):
     pa = pytest.importorskip("pyarrow")
     pq = pytest.importorskip("pyarrow.parquet")
     n = 64
-    g = rng.normal(0, 1.0, (n, 3))
+    g = rng.normal(0, 0.02, (n, 3)) + [0.5, -1.0, 2.0]  # constant turns with MEMS-like noise [rad/s]
     t = 1000.0 + np.arange(n) / 200.0
     table = pa.table({"time": t, "gyro_x": g[:, 0], "gyro_y": g[:, 1], "gyro_z": g[:, 2],
                       "temp": np.full(n, 31.5), "counter": np.arange(n, dtype=np.int32)})

@@ -50,3 +50,16 @@ def test_short_runs_are_kept_and_bad_arguments(rng):
         find_saturation(np.zeros((5, 2)))
     with pytest.raises(InputError, match="full_scale must be finite and > 0"):
         find_saturation(m, full_scale=0)
+
+
+@pytest.mark.parametrize("sign", [1, -1])
+def test_run_at_one_extreme_is_found_when_the_other_sign_reaches_further(rng, sign):
+    # int16 counts clipped at +32767 for 40 samples, one reading at -32768 elsewhere (and the mirror)
+    m = np.round(rng.normal(0, 300, (1000, 3)))
+    m[400:440, 1] = 32767 * sign
+    m[700, 1] = -32768 * sign
+    m[:, 0] = 3.0  # a quiet constant axis with one spike: its run fails the median rule
+    m[50, 0] = -100.0
+    sat = find_saturation(m)
+    np.testing.assert_array_equal(np.flatnonzero(sat[:, 1]), np.arange(400, 440))
+    assert not sat[:, 0].any() and not sat[:, 2].any()

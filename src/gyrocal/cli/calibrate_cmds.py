@@ -25,6 +25,7 @@ from ..errors import GyrocalError, InputError
 from ..segmentation import describe_found
 from ..units import from_rad_s, parse_input_unit, parse_rate_unit, unit_factor
 from ..windows import Window
+from ._outputs import check_output, same_text, starts_with
 from .app import app, console, warn, warnings_as_lines
 from .thermal_cmds import OutOfRangePolicy as OutOfRange
 
@@ -80,6 +81,7 @@ Angle = Annotated[float | None, typer.Option(
 PlotPath = Annotated[Path | None, typer.Option("--plot", help="Write a picture (.png, .pdf or .svg).")]
 Output = Annotated[Path | None, typer.Option("-o", "--output", help="Output file.")]
 Force = Annotated[bool, typer.Option("--force", help="Replace an output that holds a different calibration.")]
+_APPLIED = "corrected by gyrocal"  # first line of an apply output: a later apply may replace it
 
 
 def _required_units(units: str | None) -> str:
@@ -160,16 +162,6 @@ def _same_calibration(path: Path, doc: dict) -> bool:
         return False
     strip = ("created_by",)
     return {k: v for k, v in old.items() if k not in strip} == {k: v for k, v in doc.items() if k not in strip}
-
-
-def _check_output(path: Path | None, doc: dict, force: bool) -> None:
-    """Refuse to replace a different calibration (or any other file) without --force."""
-    if path is None or force or not path.exists():
-        return
-    if path.is_dir():
-        raise InputError(f"-o {path} is a directory; give a file name such as {path / 'cal.json'}")
-    if not _same_calibration(path, doc):
-        raise InputError(f"-o {path} already holds a different calibration or another file; pass --force to replace it")
 
 
 def _params_table(run, truth: Calibration | None = None):
@@ -271,9 +263,8 @@ def calibrate(
         units = units or "deg/s"
         if speed is None and angle is None and windows is None:
             speed = EXAMPLE_SPEED
-        console.print(f"example: {recording}\n  same as: gyrocal calibrate {recording} --units deg/s "
-                      + (f"--speed {speed:g}" if speed is not None else f"--angle {360 if angle is None else angle:g}"),
-                      highlight=False)
+        intro = (f"example: {recording}\n  same as: gyrocal calibrate {recording} --units deg/s "
+                 + (f"--speed {speed:g}" if speed is not None else f"--angle {360 if angle is None else angle:g}"))
     if recording is None:
         raise InputError("give a recording to calibrate (or --example for the bundled one)")
     units = _required_units(units)
@@ -288,14 +279,21 @@ def calibrate(
                           output_units=rate_unit)
     cal = run.calibration
     doc = to_document(cal)
-    _check_output(output, doc, force)
-    _print_calibration(run, None if truth_path is None else _truth_calibration(truth_path, cal))
+    inputs = (Path(recording), windows)
+    check_output(output, inputs=inputs, force=force, replaceable=lambda p: _same_calibration(p, doc),
+                 holds="a different calibration or another file")
+    check_output(plot, flag="--plot", inputs=inputs + (output,), force=True)
+    # files first: a reader that closes stdout early (| head) must not cost the outputs
     if plot is not None:
         _save_plot(plot, rec, _windows_of(cal), cal, speed_rad, f"{Path(recording).name}: {reference} reference")
     if output is not None:
         from .._jsonfile import write_json
 
         write_json(output, doc)
+    if example:
+        console.print(intro, highlight=False)
+    _print_calibration(run, None if truth_path is None else _truth_calibration(truth_path, cal))
+    if output is not None:
         console.print(f"wrote {output}" + (f" and {plot}" if plot is not None else ""), highlight=False)
 
 
@@ -340,6 +338,7 @@ def segments(
     units = _required_units(units)
     rate_unit = _rate_unit(units, output_units)
     reference, speed_rad, angle_rad = _reference(speed, angle, rate_unit)
+    check_output(plot, flag="--plot", inputs=(recording, windows), force=True)
     rec = _read(recording, units, columns, sample_rate, sensitivity, output_units, topic, saturation, no_unit_check)
     given = _windows_from_file(windows, rec)
     ignored: list = []
@@ -407,11 +406,14 @@ def apply(
     = ThermalModel.lagrange,
     out_of_range: Annotated[OutOfRange, typer.Option(
         "--out-of-range", help="Thermal files: temperatures outside the calibrated range.")] = OutOfRange.refuse,
+    force: Annotated[bool, typer.Option("--force", help="Replace an existing output that gyrocal did not write.")]
+    = False,
 ) -> None:
     """Correct a recording; gyro columns are replaced by corrected rates, other columns pass through."""
     from ..export import load_any
     from ..io import write_csv
 
+    check_output(output, inputs=(calibration, recording), force=force, replaceable=starts_with(f"# {_APPLIED}"))
     cal = load_any(calibration)
     expected = cal.input_units
     if units is not None and parse_input_unit(units, "--units") != expected:
@@ -434,7 +436,7 @@ def apply(
             cols[name] = value if name != "table_rate" or rec.units == "counts" else from_rad_s(value, expected)
     for name, value in rec.extra.items():
         cols.setdefault(name, value)
-    note = f"corrected by gyrocal with {Path(calibration).name}; gx gy gz in {out_units}"
+    note = f"{_APPLIED} with {Path(calibration).name}; gx gy gz in {out_units}"
     write_csv(output, cols, header_comment=note)
     console.print(f"wrote {output} ({len(rec)} rows, gx gy gz in {out_units})", highlight=False)
 
@@ -455,9 +457,13 @@ def export(
     calibration: Annotated[Path, typer.Argument(help="A gyrocal calibration or thermal calibration file.")],
     format: Annotated[ExportFormatName, typer.Option("--format", help="Output format.")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Output file.")],
+    force: Force = False,
 ) -> None:
     """Write a calibration file as JSON, YAML or a C header for firmware."""
-    from ..export import export_file
+    from .._atomic import write_text_atomic
+    from ..export import render
 
-    export_file(calibration, format.value, output)
+    text = render(calibration, format.value)
+    check_output(output, inputs=(calibration,), force=force, replaceable=same_text(text))
+    write_text_atomic(output, text)
     console.print(f"wrote {output} ({format.value})", highlight=False)

@@ -19,6 +19,12 @@ SaturationPolicy = Literal["error", "drop", "ignore"]
 #: No MEMS gyro measures beyond about 2000 deg/s (4000 for a few); above this, rad/s is a unit mistake.
 MAX_PLAUSIBLE_RAD_S = math.radians(2000.0)
 MAX_PLAUSIBLE_DEG_S = 5000.0
+#: MEMS gyros sample at 0.5 Hz-100 kHz; a time step outside that is a time column not in seconds.
+MIN_SAMPLE_RATE, MAX_SAMPLE_RATE = 0.5, 100e3
+#: Per-sample noise [rad/s] above any MEMS gyro's (about 0.01 typical): deg/s data declared as rad/s.
+MAX_PLAUSIBLE_NOISE_RAD_S = 0.3
+#: Samples the noise estimate looks at: enough for a robust median, bounded on long logs.
+NOISE_SAMPLES = 100_000
 
 
 def _check_finite(data: dict, source: str) -> None:
@@ -47,12 +53,30 @@ def _check_time(t: np.ndarray, source: str) -> float:
         i = int(np.argmin(increasing))
         what = "a duplicated timestamp" if t[i + 1] == t[i] else "time going backwards"
         raise InputError(
-            f"{source}: {what} at data row {i + 2} (t={t[i]!r} then {t[i + 1]!r}); "
+            # float(): plain numbers, not numpy reprs; str keeps every digit of epoch stamps
+            f"{source}: {what} at data row {i + 2} (t={float(t[i])} then {float(t[i + 1])}); "
             "times must increase strictly: sort the log and drop repeated rows"
         )
     # the median of up to 100 000 evenly spread steps: nominal, and cheap on long logs
     i = np.linspace(0, len(t) - 2, min(len(t) - 1, 100_000)).astype(np.intp)
-    return 1.0 / float(np.median(t[i + 1] - t[i]))
+    step = float(np.median(t[i + 1] - t[i]))
+    fs = 1.0 / step
+    # ms or ns stamps under a plain name (t, time, timestamp) read as seconds; the 1e-6 slack
+    # lets stamps at exactly 0.5 Hz or 100 kHz through despite rounding
+    if not MIN_SAMPLE_RATE * (1 - 1e-6) <= fs <= MAX_SAMPLE_RATE * (1 + 1e-6):
+        raise InputError(
+            f"{source}: the median time step is {step:.6g}, {fs:.3g} Hz if the times are seconds, "
+            "outside the 0.5 Hz-100 kHz of a gyro; times in ms, us or ns need the unit in the column's name: "
+            "rename it e.g. time_ms, time_us or time_ns"
+        )
+    return fs
+
+
+def _noise(raw: np.ndarray) -> float:
+    """Per-sample noise, robust to turns: median |first difference| / (0.6745 sqrt 2), on the quietest
+    axis so that one shaking axis cannot make rad/s data look like deg/s."""
+    d = np.abs(np.diff(raw[:NOISE_SAMPLES + 1], axis=0))
+    return float(np.min(np.median(d, axis=0))) / (0.6745 * math.sqrt(2.0))
 
 
 def _check_units(raw: np.ndarray, unit: str, sensitivity: float | None, source: str) -> None:
@@ -67,6 +91,12 @@ def _check_units(raw: np.ndarray, unit: str, sensitivity: float | None, source: 
     elif unit == "rad/s" and peak > MAX_PLAUSIBLE_RAD_S:
         raise UnitError(
             f"{source}: rates reach {peak:.4g} rad/s ({math.degrees(peak):.4g} deg/s), beyond any MEMS gyro's range; "
+            "the data are almost surely in deg/s: use --units deg/s (or --no-unit-check)"
+        )
+    elif unit == "rad/s" and (noise := _noise(raw)) > MAX_PLAUSIBLE_NOISE_RAD_S:
+        # slow turns in deg/s stay under the peak test, but their noise is 57 times too large
+        raise UnitError(
+            f"{source}: the per-sample noise is {noise:.3g} rad/s, far above any MEMS gyro's (about 0.01); "
             "the data are almost surely in deg/s: use --units deg/s (or --no-unit-check)"
         )
     elif unit == "deg/s" and peak > MAX_PLAUSIBLE_DEG_S and np.array_equal(raw, np.round(raw)):

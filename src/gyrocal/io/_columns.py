@@ -71,7 +71,8 @@ def resolve(names: Sequence[str], columns: Mapping[str, str] | None, source: str
     Raises
     ------
     InputError
-        A mapped column is absent, an alias is ambiguous, or ``gx, gy, gz`` cannot be found.
+        A mapped column is absent, an alias is ambiguous, ``gx, gy, gz`` cannot be found, or
+        a column used is named twice in the header.
     """
     names = [str(n) for n in names]
     by_lower = {}
@@ -106,6 +107,12 @@ def resolve(names: Sequence[str], columns: Mapping[str, str] | None, source: str
             f"{source}: no column for {', '.join(missing)}; columns found: {_found(names)}; "
             "map them with --columns gx=NAME,gy=NAME,gz=NAME"
         )
+    for canon, name in mapping.items():
+        if names.count(name) > 1:  # readers would silently keep one of the copies
+            raise InputError(
+                f"{source}: column name {name!r} (used for {canon}) appears {names.count(name)} times in the header; "
+                "rename the copies so that every name is unique"
+            )
     return mapping
 
 

@@ -6,6 +6,7 @@ for whitespace-separated files, a pure-Python reader does the same job more slow
 
 from __future__ import annotations
 
+import codecs
 import csv
 import os
 from pathlib import Path
@@ -49,11 +50,27 @@ def sniff(lines: list[str], source: str = "file") -> tuple[int, str | None]:
     return h, best
 
 
-def _head(path: Path) -> list[str]:
+# UTF-32 first: its little-endian BOM starts with UTF-16's
+_BOMS = ((codecs.BOM_UTF32_LE, "utf-32"), (codecs.BOM_UTF32_BE, "utf-32"),
+         (codecs.BOM_UTF16_LE, "utf-16"), (codecs.BOM_UTF16_BE, "utf-16"))
+
+
+def _head(path: Path) -> tuple[list[str], str]:
+    """The first lines of a text table, and its encoding: UTF-8 unless a UTF-16/32 BOM says otherwise
+    (Excel's "Unicode text" is UTF-16); both readers decode that encoding, which drops the BOM."""
     with open(path, "rb") as f:
         raw = f.read(_HEAD_BYTES)
-    lines = raw.decode("utf-8-sig", errors="replace").splitlines()
-    return lines[:-1] if len(raw) == _HEAD_BYTES and len(lines) > 1 else lines  # the last line may be cut
+    encoding = next((enc for bom, enc in _BOMS if raw.startswith(bom)), "utf-8-sig")
+    lines = raw.decode(encoding, errors="replace").splitlines()
+    return (lines[:-1] if len(raw) == _HEAD_BYTES and len(lines) > 1 else lines), encoding  # the last line may be cut
+
+
+def _is_number(cell: str) -> bool:
+    try:
+        float(cell)
+    except ValueError:
+        return False
+    return True
 
 
 def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool | None = None):
@@ -75,9 +92,15 @@ def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool
         Every other column -> array of text, in file order.
     """
     path = Path(path)
-    lines = _head(path)
+    lines, encoding = _head(path)
     h, delimiter = sniff(lines, path.name)
     names = _split(lines[h], delimiter)
+    if all(_is_number(n) for n in names):
+        sep = delimiter or " "
+        raise InputError(
+            f"{path.name}: the first line ({lines[h][:40].strip()!r}) is data, not a header; add a header row "
+            f"naming the columns, e.g. {sep.join(('t', 'gx', 'gy', 'gz'))!r} (t optional with --sample-rate)"
+        )
     mapping = resolve(names, columns, path.name)
     if use_pyarrow is None:
         try:
@@ -87,9 +110,9 @@ def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool
         except ImportError:
             use_pyarrow = False
     if use_pyarrow and delimiter is not WHITESPACE and len(set(names)) == len(names):
-        cols = _read_arrow(path, h, delimiter, names, mapping)
+        cols = _read_arrow(path, h, delimiter, names, mapping, encoding)
     else:
-        cols = _read_python(path, h, delimiter, names, mapping)
+        cols = _read_python(path, h, delimiter, names, mapping, encoding)
     numeric = {mapping[c] for c in NUMERIC if c in mapping}
     data = {c: cols[mapping[c]] for c in mapping}
     for c in mapping:
@@ -101,7 +124,7 @@ def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool
     return data, extra
 
 
-def _read_arrow(path: Path, h: int, delimiter: str, names: list[str], mapping: dict) -> dict:
+def _read_arrow(path: Path, h: int, delimiter: str, names: list[str], mapping: dict, encoding: str) -> dict:
     import pyarrow as pa
     import pyarrow.csv as pcsv
 
@@ -117,7 +140,8 @@ def _read_arrow(path: Path, h: int, delimiter: str, names: list[str], mapping: d
             convert_options=pcsv.ConvertOptions(column_types=types, strings_can_be_null=False),
         )
 
-    as_float, encoding = True, "utf8"
+    # pyarrow reads UTF-8 (its BOM included) natively and transcodes anything else
+    as_float, encoding = True, "utf8" if encoding == "utf-8-sig" else encoding
     for _ in range(3):
         try:
             table = read(as_float, encoding)
@@ -147,8 +171,8 @@ def _read_arrow(path: Path, h: int, delimiter: str, names: list[str], mapping: d
     return {n: cols[n] if n in cols else table.column(n).to_numpy() for n in names}
 
 
-def _read_python(path: Path, h: int, delimiter: str | None, names: list[str], mapping: dict) -> dict:
-    with open(path, encoding="utf-8-sig", errors="replace", newline="") as f:
+def _read_python(path: Path, h: int, delimiter: str | None, names: list[str], mapping: dict, encoding: str) -> dict:
+    with open(path, encoding=encoding, errors="replace", newline="") as f:
         lines = [line for line in f.read().splitlines()[h + 1:] if line.strip()]
     if delimiter is WHITESPACE:
         rows = [line.split() for line in lines]

@@ -74,8 +74,8 @@ def read_recording(
     topic : str, optional
         Bag topic, needed when several topics carry ``sensor_msgs/Imu``.
     check_units : bool
-        Refuse likely unit mistakes: rad/s data beyond 2000 deg/s, integer "deg/s" data
-        beyond 5000 deg/s, non-integer counts.
+        Refuse likely unit mistakes: rad/s data beyond 2000 deg/s or with a per-sample
+        noise above 0.3 rad/s, integer "deg/s" data beyond 5000 deg/s, non-integer counts.
     saturation : {"error", "drop", "ignore"}
         What to do with samples stuck at full scale (see :func:`find_saturation`).
     full_scale : float, optional

@@ -35,8 +35,9 @@ def find_saturation(gyro, full_scale: float | None = None, *, min_run: int = MIN
     full_scale : float, optional
         Sensor limit [same unit as `gyro`]. Readings with ``|m| >= full_scale`` are saturated.
         Without it, a sample is saturated when it belongs to a run of at least `min_run`
-        identical readings at the axis's largest magnitude ``+-max|m|``, and that level is
-        more than twice the axis's median magnitude (a quiet, constant axis is not saturated).
+        identical readings at the axis's maximum or at its minimum (each tested on its own),
+        and that level's magnitude is more than twice the axis's median magnitude (a quiet,
+        constant axis is not saturated).
     min_run : int
         Shortest run of stuck samples counted when `full_scale` is not given.
 
@@ -62,17 +63,17 @@ def find_saturation(gyro, full_scale: float | None = None, *, min_run: int = MIN
         col = g[:, j]  # column by column: numpy reduces a strided 1-D view far faster than axis=0 of (N, 3)
         if len(col) == 0:
             continue
-        hi, lo = col.max(), col.min()
-        level = max(abs(hi), abs(lo))
-        if not np.isfinite(level) or level == 0:
-            continue
-        if abs(hi) != abs(lo):  # only one sign reaches the extreme: one comparison pass
-            stuck = col == (hi if abs(hi) > abs(lo) else lo)
-        else:
-            stuck = (col == level) | (col == -level)
-        if np.count_nonzero(stuck) < min_run:  # the common case: no pile-up at the extreme
-            continue
-        runs = _long_runs(stuck, int(min_run))
-        if runs.any() and level > 2.0 * np.median(np.abs(col)):
-            mask[:, j] = runs
+        median = None
+        # each extreme on its own: a run stuck at +32767 counts even when one sample reads -32768
+        for level in {col.max(), col.min()}:  # a set: one pass for a constant axis
+            if not np.isfinite(level) or level == 0:
+                continue
+            stuck = col == level
+            if np.count_nonzero(stuck) < min_run:  # the common case: no pile-up at this extreme
+                continue
+            runs = _long_runs(stuck, int(min_run))
+            if runs.any():
+                median = np.median(np.abs(col)) if median is None else median  # a sort: only when needed
+                if abs(level) > 2.0 * median:
+                    mask[:, j] |= runs
     return mask
