@@ -48,7 +48,32 @@ def test_simulate_turntable_and_profile(tmp_path):
     assert "--profile" in refused("simulate", "-o", tmp_path / "q.csv", "--protocol", "profile")
 
 
-def test_noise_command_writes_json_and_plot(tmp_path, rng):
+def test_simulate_turntable_flags_shape_the_session(tmp_path):
+    out = tmp_path / "tt.csv"
+    code, _, err = invoke("simulate", "-o", out, "--protocol", "turntable", "--temps", "-10,30", "--rates", "0,20",
+                          "--step-duration", "1", "--sample-rate", "20", "--temp-noise", "0.5", "--temp-quantum", "1",
+                          "--seed", "3")
+    assert code == 0, err
+    rec = read_recording(out, units="deg/s")
+    assert len(rec) == 2 * 3 * 3 * 20  # temps x positions x (0, +20, -20) x samples per step
+    assert set(np.round(np.degrees(rec.table_rate), 9)) == {0.0, 20.0, -20.0}  # read back in rad/s
+    assert np.all(rec.temp == np.round(rec.temp))  # whole degrees
+    first, second = rec.temp[: len(rec) // 2], rec.temp[len(rec) // 2:]
+    assert np.all(np.abs(first + 10) <= 3) and np.all(np.abs(second - 30) <= 3)
+    assert 0.3 < np.std(first) < 0.8  # 0.5 degC noise, rounded to 1 degC: ~0.58
+    settings = json.loads((tmp_path / "tt.truth.json").read_text())["settings"]
+    assert settings["temps_degC"] == [-10.0, 30.0] and settings["rates_deg_s"] == [0.0, 20.0]
+    assert settings["step_duration_s"] == 1.0 and settings["temp_quantum_degC"] == 1.0
+    line = refused("simulate", "-o", out, "--protocol", "turntable", "--speed", "30")
+    assert "--speed" in line and "turntable" in line
+    assert "--temps" in refused("simulate", "-o", out, "--temps", "0,10")
+    assert "--temp-quantum" in refused("simulate", "-o", out, "--protocol", "turntable", "--temp-quantum", "0")
+
+
+def test_noise_command_writes_json_and_plot(tmp_path, rng, monkeypatch):
+    from gyrocal.cli.app import console
+
+    monkeypatch.setattr(console, "_width", 80)
     static = tmp_path / "static.csv"
     m = rng.standard_normal((30000, 3)) * 0.01
     np.savetxt(static, np.column_stack([np.arange(30000) / 100.0, m]), delimiter=",", header="t,gx,gy,gz",
@@ -56,6 +81,7 @@ def test_noise_command_writes_json_and_plot(tmp_path, rng):
     code, out, err = invoke("noise", static, "--units", "rad/s", "--json", tmp_path / "n.json", "--plot",
                             tmp_path / "a.png")
     assert code == 0, err
+    assert "bias inst." in out and "\u2026" not in out  # no header cut at 80 columns
     report = load_noise(tmp_path / "n.json")
     # ARW at short tau from 30,000 samples: relative sd well below 1 %
     np.testing.assert_allclose(report.arw, 0.01 / math.sqrt(100.0), rtol=0.03)
@@ -80,6 +106,19 @@ def test_study_command_with_progress(tmp_path):
     assert (tmp_path / "convergence.md").exists() and "wrote" in out
     assert "servo-speed" in refused("study", "servo-normal", "-o", tmp_path, "--methods", "lm")
     assert "--gyros" in refused("study", "servo-normal", "-o", tmp_path, "--gyros", "0")
+
+
+def test_study_flags_are_used_or_refused(tmp_path):
+    code, out, err = invoke("study", "thermal-compare", "-o", tmp_path, "--gyros", "1", "--reps", "1",
+                            "--sample-rate", "20", "--noise-density", "0.001")
+    assert code == 0, err
+    assert "1/1" in out  # the progress bar ends full
+    # 0.001 rad/s/sqrt(Hz) at 20 Hz, averaged over (10 s - 2 s settle) x 20 Hz samples per step
+    floor = math.degrees(0.001 * math.sqrt(20)) / math.sqrt(8 * 20)
+    assert f"noise floor of a step mean {floor:.3g}" in " ".join(out.split())  # the summary wraps
+    line = refused("study", "servo-convergence", "-o", tmp_path, "--gyros", "2")
+    assert "--gyros" in line and "servo-convergence" in line
+    assert "--speed" in refused("study", "thermal-compare", "-o", tmp_path, "--speed", "30")
 
 
 def test_installed_entry_point_runs_a_study(tmp_path):

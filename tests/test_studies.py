@@ -86,11 +86,21 @@ def test_servo_convergence_table(tmp_path):
 
 
 def test_thermal_compare_table_beats_traditional(tmp_path):
-    run_study("thermal-compare", tmp_path, gyros=1, seed=1, step_duration=4.0, sample_rate=50.0)
+    from gyrocal.studies.thermal_compare import NOISE, step_noise_floor
+
+    calls = []
+    run_study("thermal-compare", tmp_path, gyros=2, seed=1, step_duration=4.0, sample_rate=50.0,
+              progress=lambda n, label: calls.append(n))
+    assert sum(calls) == study_units("thermal-compare", gyros=2) == 2
     rows = _rows(tmp_path / "by_temperature.csv")
     far = [r for r in rows if abs(float(r["temp [degC]"]) - 25) > 20]
     assert far and all(float(r["lagrange rms [deg/s]"]) < float(r["traditional rms [deg/s]"]) for r in far)
     assert len(_rows(tmp_path / "table34.csv")) == 9
+    # Each RMS is over 2 gyros x 63 steps x 3 axes, relative sd ~ 1/sqrt(2 * 378) = 4 %: none beats the floor.
+    floor = step_noise_floor(NOISE, 50.0, 4.0)
+    smooth = [float(r["smooth rms [deg/s]"]) / floor for r in rows]
+    assert 0.85 < min(smooth) < 1.15  # and the smooth model reaches it
+    assert all(float(r["lagrange rms [deg/s]"]) > 0.85 * floor for r in rows)
 
 
 def test_run_study_rejects_bad_arguments(tmp_path):
@@ -98,15 +108,17 @@ def test_run_study_rejects_bad_arguments(tmp_path):
         run_study("servo-fast", tmp_path)
     with pytest.raises(InputError, match="--gyros"):
         run_study("servo-normal", tmp_path, gyros=0)
+    with pytest.raises(InputError, match="--gyros does not apply"):
+        run_study("servo-convergence", tmp_path, gyros=2)
     assert set(STUDY_NAMES) >= {"servo-normal", "servo-speed", "thermal-compare"}
 
 
 def test_study_plots_draw_their_artists():
     from gyrocal.plotting._mpl import new_figure
-    from gyrocal.plotting.studies import convergence, error_boxes, mse_vs_speed
+    from gyrocal.plotting.studies import convergence, error_boxes, mse_vs_speed, rms_by_temperature
 
     fig = new_figure()
-    ax1, ax2, ax3 = fig.subplots(1, 3)
+    ax1, ax2, ax3, ax4 = fig.subplots(1, 4)
     errors = np.random.default_rng(0).standard_normal((200, 6)) * 1e-3
     art = error_boxes(ax1, errors, np.full(6, 1e-3))
     assert len(art["boxes"]) == 6 and len(art["crb"]) == 2
@@ -117,3 +129,7 @@ def test_study_plots_draw_their_artists():
     lines = convergence(ax3, history, np.array([1.0] * 3 + [0.1] * 3))
     assert len(lines) == 6
     np.testing.assert_allclose(lines[0].get_ydata(), [0.1, 1e-12], atol=1e-12)
+    lines = rms_by_temperature(ax4, [0.0, 10.0], {"lagrange": [0.02, 0.03]}, floor=0.01)
+    assert len(lines) == 2 and lines[1].get_linestyle() == "--"
+    np.testing.assert_allclose(lines[1].get_ydata(), 0.01)
+    assert "noise floor" in lines[1].get_label()

@@ -42,7 +42,10 @@ def files(tmp_path_factory):
             "two_axes": _write(two_axes, root / "two_axes.csv"), "root": root}
 
 
-def test_thermal_then_report(files, tmp_path, capsys):
+def test_thermal_then_report(files, tmp_path, capsys, monkeypatch):
+    from gyrocal.cli.app import console
+
+    monkeypatch.setattr(console, "_width", 100)
     out = tmp_path / "thermal.json"
     assert run(["thermal", str(files["session"]), "--units", "deg/s", "-o", str(out), "--full-scale", "300",
                 "--settle", "1"]) == 0
@@ -51,6 +54,12 @@ def test_thermal_then_report(files, tmp_path, capsys):
     doc = json.loads(out.read_text())
     assert doc["format"] == "gyrocal.thermal" and doc["units"]["input"] == "deg/s"
     assert [p["temp"] for p in doc["points"]] == [-20.0, 0.0, 20.0, 40.0]
+    # Every point's row ends with its largest std of scale factors, misalignments and biases [deg/s].
+    assert "sd mis" in captured.out and "sd B" in captured.out
+    for p in doc["points"]:
+        std = np.array(p["std"])
+        row = next(line for line in captured.out.splitlines() if line.split()[:1] == [f"{p['temp']:.1f}"])
+        assert row.split()[-3:] == [f"{v:.1e}" for v in (std[:3].max(), std[3:9].max(), np.degrees(std[9:]).max())]
     rep = tmp_path / "report"
     assert run(["thermal-report", str(out), str(files["test"]), "-o", str(rep), "--settle", "1",
                 "--full-scale", "300"]) == 0

@@ -41,16 +41,42 @@ NoiseDensity = Annotated[Optional[str], typer.Option(
     help="White-noise density: rad/s/sqrt(Hz), 'N deg/s/rtHz', or a noise JSON from 'gyrocal noise --json'.")]
 
 
-def _triple(name: str, text: str | None, default) -> np.ndarray:
-    if text is None:
-        return np.asarray(default, dtype=float)
+def _numbers(name: str, text: str) -> list[float]:
+    """Comma-separated finite numbers."""
     try:
         values = [float(v) for v in text.split(",")]
     except ValueError:
-        raise InputError(f"{name} must be three comma-separated numbers, got {text!r}") from None
-    if len(values) != 3 or not all(map(math.isfinite, values)):
-        raise InputError(f"{name} must be three comma-separated finite numbers, got {text!r}")
+        raise InputError(f"{name} must be comma-separated numbers, got {text!r}") from None
+    if not all(map(math.isfinite, values)):
+        raise InputError(f"{name} must be finite numbers, got {text!r}")
+    return values
+
+
+def _triple(name: str, text: str | None, default) -> np.ndarray:
+    if text is None:
+        return np.asarray(default, dtype=float)
+    values = _numbers(name, text)
+    if len(values) != 3:
+        raise InputError(f"{name} must be three comma-separated numbers, got {text!r}")
     return np.asarray(values)
+
+
+def _given(ctx: typer.Context, name: str) -> bool:
+    """Whether parameter `name` was typed on the command line rather than left at its default."""
+    source = ctx.get_parameter_source(name)
+    return source is not None and source.name == "COMMANDLINE"
+
+
+def _refuse_unused(ctx: typer.Context, users: dict[str, tuple[str, ...]], choice: str, what: str) -> None:
+    """Refuse a flag given on the command line that `choice` does not use: ignoring it would mislead.
+
+    `users` maps a parameter name to the choices that use it; parameters not in it apply to all.
+    """
+    for param in ctx.command.params:
+        if param.name in users and choice not in users[param.name] and _given(ctx, param.name):
+            flag = max(param.opts, key=len)
+            raise InputError(f"{flag} does not apply to {what} {choice} (only to {', '.join(users[param.name])}); "
+                             "drop it")
 
 
 def _noise_std(noise: float | None, density: str | None, sample_rate: float, default: float) -> np.ndarray:
@@ -80,8 +106,42 @@ def _truth_doc(protocol: str, model, settings: dict, extra: dict) -> dict:
     return doc
 
 
+_SERVO = ("servo", "hand")
+#: Flags that only some protocols use; the rest apply to every protocol.
+_PROTOCOL_FLAGS = {
+    **dict.fromkeys(("speed", "turns", "wait", "ramp", "misalignment"), _SERVO), "vibration": ("servo",),
+    **dict.fromkeys(("k", "b"), (*_SERVO, "profile")),  # the turntable gyro follows seed 001's thermal truth
+    **dict.fromkeys(("temps", "rates", "step_duration", "temp_noise", "temp_quantum"), ("turntable",)),
+    **dict.fromkeys(("profile", "profile_units", "duration"), ("profile",)),
+}
+
+
+def _turntable_protocol(temps: str | None, rates: str | None, step_duration: float | None, temp_noise: float,
+                        temp_quantum: float | None):
+    """The seed 001 protocol from the command line's flags; unset ones keep the paper's values."""
+    from ..simulation.turntable import TurntableProtocol
+
+    kw: dict = {}
+    if temps is not None:
+        kw["temps"] = tuple(_numbers("--temps", temps))
+    if rates is not None:
+        kw["rates"] = tuple(_numbers("--rates", rates))
+        if min(kw["rates"]) < 0:
+            raise InputError(f"--rates are magnitudes >= 0 deg/s (each runs forward and reverse), got {rates!r}")
+    if step_duration is not None:
+        if not (math.isfinite(step_duration) and step_duration > 0):
+            raise InputError(f"--step-duration must be > 0 s, got {step_duration:g}")
+        kw["step_duration"] = step_duration
+    if not (math.isfinite(temp_noise) and temp_noise >= 0):
+        raise InputError(f"--temp-noise must be >= 0 degC, got {temp_noise:g}")
+    if temp_quantum is not None and not (math.isfinite(temp_quantum) and temp_quantum > 0):
+        raise InputError(f"--temp-quantum must be > 0 degC (e.g. 1 for whole degrees), got {temp_quantum:g}")
+    return TurntableProtocol(**kw, temp_noise=temp_noise, temp_quantum=temp_quantum)
+
+
 @app.command()
 def simulate(
+    ctx: typer.Context,
     output: Annotated[Path, typer.Option(
         "-o", "--output", help="Recording to write (CSV); the truth goes to *.truth.json.")],
     protocol: Annotated[ProtocolName, typer.Option("--protocol", help="Motion source.")] = ProtocolName.servo,
@@ -102,6 +162,20 @@ def simulate(
     profile: Annotated[Optional[Path], typer.Option("--profile", help="--protocol profile: CSV of t,wx,wy,wz.")] = None,
     profile_units: Annotated[str, typer.Option("--profile-units", help="Unit of the profile rates.")] = "rad/s",
     duration: Annotated[Optional[float], typer.Option("--duration", help="--protocol profile: length [s].")] = None,
+    temps: Annotated[Optional[str], typer.Option(
+        "--temps", help="--protocol turntable: temperatures [degC], comma-separated (default: seed 001 Table 1, "
+                        "-40 to 50 by 10).")] = None,
+    rates: Annotated[Optional[str], typer.Option(
+        "--rates", help="--protocol turntable: rates [deg/s], comma-separated, each run forward and reverse "
+                        "(default: seed 001 Table 2, 0 to 400).")] = None,
+    step_duration: Annotated[Optional[float], typer.Option(
+        "--step-duration", help="--protocol turntable: length of each rate step [s] (default: 60, the paper's).")]
+    = None,
+    temp_noise: Annotated[float, typer.Option(
+        "--temp-noise", help="--protocol turntable: std of each temperature reading [degC].")] = 0.0,
+    temp_quantum: Annotated[Optional[float], typer.Option(
+        "--temp-quantum", help="--protocol turntable: resolution of the temperature readings [degC], e.g. 1.")]
+    = None,
     sample_rate: Annotated[float, typer.Option("--sample-rate", help="Sampling rate [Hz].")] = 200.0,
     units: Annotated[str, typer.Option("--units", help="Unit of the written gyro columns.")] = "deg/s",
     seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
@@ -113,6 +187,7 @@ def simulate(
     from ..simulation import VirtualGyro
     from ..units import from_rad_s, parse_rate_unit
 
+    _refuse_unused(ctx, _PROTOCOL_FLAGS, protocol.value, "--protocol")
     unit = parse_rate_unit(units)
     rng = np.random.default_rng(seed)
     sd = _noise_std(noise, noise_density, sample_rate, 0.035 if protocol != ProtocolName.turntable else 0.005)
@@ -141,10 +216,15 @@ def simulate(
         from ..simulation.thermal_truth import ThermalTruth
         from ..simulation.turntable import simulate_turntable
 
+        proto = _turntable_protocol(temps, rates, step_duration, temp_noise, temp_quantum)
         thermal = ThermalTruth()
         K, B = thermal(np.array([thermal.ref_temp]))
         model = Affine(K[0], B[0])
-        rec = simulate_turntable(VirtualGyro(model, thermal=thermal, **gyro_kw), sample_rate=sample_rate, rng=rng)
+        rec = simulate_turntable(VirtualGyro(model, thermal=thermal, **gyro_kw), proto, sample_rate=sample_rate,
+                                 rng=rng)
+        settings.update(temps_degC=list(proto.temps), rates_deg_s=list(proto.rates), axes=list(proto.axes),
+                        step_duration_s=proto.step_duration, table_tau_s=proto.table_tau,
+                        temp_noise_degC=proto.temp_noise, temp_quantum_degC=proto.temp_quantum)
         extra = {"thermal": {"ref_temp": thermal.ref_temp, "kg_ref": list(map(float, thermal.kg_ref)),
                              "scale_slope": list(thermal.scale_slope),
                              "bias_poly_deg_s": [list(r) for r in thermal.bias_poly]}}
@@ -188,9 +268,10 @@ def noise(
     rec = _read(recording, units, columns, sample_rate, None, None, None)
     report = characterise(rec.gyro, rec.sample_rate)
     table = Table(title=f"{recording.name}: {report.duration:.0f} s at {report.sample_rate:g} Hz")
-    for col in ("axis", "ARW (deg/sqrt(h))", "density (rad/s/sqrt(Hz))", "sigma/sample (rad/s)",
-                "bias instability (deg/h)", "at tau (s)", "RRW (deg/h/sqrt(h))"):
-        table.add_column(col, justify="right")
+    # Short names over their units, so the table fits 80 columns without cutting a header.
+    for col in ("axis", "ARW\ndeg/\u221ah", "density\nrad/s/\u221aHz", "\u03c3/sample\nrad/s", "bias inst.\ndeg/h",
+                "at \u03c4\ns", "RRW\ndeg/h/\u221ah"):
+        table.add_column(col, justify="right", no_wrap=True)
     def shown(value: float, factor: float, missing: str) -> str:
         return f"{value * factor:.4g}" if math.isfinite(value) else missing
 
@@ -285,8 +366,18 @@ def plan(
     console.print(table)
 
 
+_SERVO_STUDIES = ("servo-normal", "servo-extreme", "servo-speed", "servo-convergence")
+#: Flags that only some studies use; a study refuses the others instead of ignoring them.
+_STUDY_FLAGS = {
+    "gyros": ("servo-normal", "servo-extreme", "servo-speed", "thermal-compare"),  # convergence: Table I's 3 gyros
+    "methods": ("servo-speed",),
+    "speed": ("servo-normal", "servo-extreme", "servo-convergence"),  # servo-speed sweeps the speed
+}
+
+
 @app.command()
 def study(
+    ctx: typer.Context,
     name: Annotated[StudyChoice, typer.Argument(help="Which study.")],
     out: Annotated[Path, typer.Option("-o", "--output", help="Output folder for figures and tables.")],
     gyros: Annotated[Optional[int], typer.Option("--gyros", help="Simulated gyros (default: the paper's).")] = None,
@@ -295,7 +386,8 @@ def study(
     methods: Annotated[Optional[str], typer.Option(
         "--methods", help="servo-speed: estimators, comma-separated (algorithm1, lm, first-moment).")] = None,
     noise_density: NoiseDensity = None,
-    sample_rate: Annotated[float, typer.Option("--sample-rate", help="Servo studies: sampling rate [Hz].")] = 200.0,
+    sample_rate: Annotated[float, typer.Option(
+        "--sample-rate", help="Sampling rate [Hz] (thermal-compare's default: 100).")] = 200.0,
     speed: Annotated[float, typer.Option(
         "--speed", help="Servo studies but servo-speed: turn speed [deg/s] (paper: 60).")] = 60.0,
 ) -> None:
@@ -304,22 +396,34 @@ def study(
 
     from ..studies import ServoSettings, run_study, study_units
 
+    _refuse_unused(ctx, _STUDY_FLAGS, name.value, "study")
     options: dict = {}
     if methods is not None:
-        if name != StudyChoice.servo_speed:
-            raise InputError("--methods applies to servo-speed only")
         options["methods"] = tuple(m.strip() for m in methods.split(",") if m.strip())
     if not (math.isfinite(speed) and speed > 0):
         raise InputError(f"--speed must be > 0 deg/s, got {speed:g}")
-    settings = ServoSettings(speed=math.radians(speed), sample_rate=sample_rate)
+    if not (math.isfinite(sample_rate) and sample_rate > 0):
+        raise InputError(f"--sample-rate must be > 0 Hz, got {sample_rate:g}")
+    settings = None
+    if name.value in _SERVO_STUDIES:
+        settings = ServoSettings(speed=math.radians(speed), sample_rate=sample_rate)
+    else:  # thermal-compare keeps its own sampling rate unless told
+        from ..studies.thermal_compare import SAMPLE_RATE
+
+        if _given(ctx, "sample_rate"):
+            options["sample_rate"] = sample_rate
+        sample_rate = options.get("sample_rate", SAMPLE_RATE)
     if noise_density is not None:
         from ..noise import noise_density_arg
 
         sd = float(np.mean(noise_density_arg(noise_density))) * math.sqrt(sample_rate)
-        settings = ServoSettings(speed=settings.speed, sample_rate=sample_rate, noise_levels=(sd,))
+        if settings is None:
+            options["noise"] = sd
+        else:
+            settings = ServoSettings(speed=settings.speed, sample_rate=sample_rate, noise_levels=(sd,))
     with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
                   TimeElapsedColumn(), console=console, transient=False) as bar:
-        task = bar.add_task(name.value, total=study_units(name.value, settings))
+        task = bar.add_task(name.value, total=study_units(name.value, settings, gyros=gyros, **options))
 
         def progress(advance: int, label: str) -> None:
             bar.update(task, advance=advance, description=f"{name.value}: {label}")

@@ -102,14 +102,21 @@ def _print_table(cal, fit) -> None:
     from rich.table import Table
 
     user = cal.kg_user
-    table = Table(title=escape(f"Kg per temperature (B and residual RMS in [{cal.input_units}])"), box=SIMPLE, padding=(0, 1), pad_edge=False)
-    for col in ("T degC", "Kxx", "Kyy", "Kzz", "Bx", "By", "Bz", "resid"):
+    c, d = unit_factor(cal.input_units), unit_factor(cal.output_units)
+    # 1-sigma in the table's units, scaled like kg_user (linear in kg); max over each group of terms.
+    std = np.concatenate([cal.std[:, :9] * (d / c), cal.std[:, 9:] / c], axis=1)
+    groups = (std[:, :3].max(axis=1), std[:, 3:9].max(axis=1), std[:, 9:].max(axis=1))
+    table = Table(title=escape(f"Kg per temperature (B, resid and sd B in [{cal.input_units}])"),
+                  caption="sd K / sd mis / sd B: largest 1-sigma of Kxx..Kzz / of the 6 misalignments / of Bx..Bz",
+                  box=SIMPLE, padding=(0, 1), collapse_padding=True, show_edge=False)
+    for col in ("T degC", "Kxx", "Kyy", "Kzz", "Bx", "By", "Bz", "resid", "sd K", "sd mis", "sd B"):
         table.add_column(escape(col), justify="right", no_wrap=True, min_width=7)
     for i, t in enumerate(cal.temps):
         k = user[i]
         table.add_row(f"{t:.1f}", *(f"{k[j]:.5f}" for j in (0, 1, 2)),
                       *(f"{k[j]:.4f}" for j in (9, 10, 11)),
-                      f"{np.max(cal.residual_rms[i]) / unit_factor(cal.input_units):.2g}")
+                      f"{np.max(cal.residual_rms[i]) / unit_factor(cal.input_units):.2g}",
+                      *(f"{g[i]:.1e}" for g in groups))
     console.print(table)
     console.print(f"{len(fit.steps)} steps; smooth model orders (Kg order): "
                   + " ".join(map(str, cal.smooth.orders.tolist())))

@@ -1,4 +1,4 @@
-"""Figures of the simulation studies (seed 000 Fig. 2, 4, 5 and Table I).
+"""Figures of the simulation studies (seed 000 Fig. 2, 4, 5 and Table I; seed 001 Tables 3-4).
 
 Functions that draw on one ``Axes`` return the artists they made; the ``*_figure``
 helpers build a headless ``Figure`` from them.
@@ -144,7 +144,8 @@ def convergence_figure(cases: Mapping[str, tuple[np.ndarray, np.ndarray]], *, ti
     return fig
 
 
-def rms_by_temperature(ax, temps, rms: Mapping[str, "np.ndarray"], *, title: str = "") -> list:
+def rms_by_temperature(ax, temps, rms: Mapping[str, "np.ndarray"], *, floor: float | None = None,
+                       title: str = "") -> list:
     """RMS compensation error against test temperature, one line per method (seed 001 Tables 3-4).
 
     Parameters
@@ -153,18 +154,25 @@ def rms_by_temperature(ax, temps, rms: Mapping[str, "np.ndarray"], *, title: str
         Test temperatures [degC].
     rms : mapping of str to array_like, shape (T,)
         RMS error per method [deg/s].
+    floor : float, optional
+        Noise floor of a test step mean [deg/s], drawn dashed: the study's bound.
     """
     lines = []
     for i, (method, values) in enumerate(rms.items()):
         (line,) = ax.semilogy(temps, values, marker="o", color=f"C{i}", label=method)
         lines.append(line)
+    if floor is not None:
+        # On top of the lines: the best methods sit right on it.
+        lines.append(ax.axhline(floor, linestyle="--", color="k", linewidth=1.0, zorder=3,
+                                label=f"noise floor of a step mean, \u03c3/\u221an = {floor:.3g} deg/s"))
     _label(ax, "test temperature [degC]", "RMS step error [deg/s]", title)
     ax.legend(fontsize=7)
     return lines
 
 
-def rms_by_temperature_figure(temps, rms: Mapping[str, "np.ndarray"], *, title: str = ""):
+def rms_by_temperature_figure(temps, rms: Mapping[str, "np.ndarray"], *, floor: float | None = None,
+                              title: str = ""):
     """A one-panel figure of :func:`rms_by_temperature`."""
     fig = new_figure((6.5, 4.2), layout="constrained")
-    rms_by_temperature(fig.subplots(), temps, rms, title=title)
+    rms_by_temperature(fig.subplots(), temps, rms, floor=floor, title=title)
     return fig

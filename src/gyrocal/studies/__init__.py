@@ -23,21 +23,22 @@ def _check(name: str) -> None:
         raise InputError(f"study {name!r} is not one of {', '.join(STUDY_NAMES)}")
 
 
-def study_units(name: StudyName, settings: ServoSettings | None = None) -> int:
-    """How many progress units :func:`run_study` will report for `name`."""
+def study_units(name: StudyName, settings: ServoSettings | None = None, *, gyros: int | None = None,
+                **options) -> int:
+    """How many progress units :func:`run_study` will report for `name` with the same arguments."""
     _check(name)
     settings = settings or ServoSettings()
     if name in ("servo-normal", "servo-extreme"):
         from .servo_errors import work_units
         return work_units(settings)
     if name == "servo-speed":
-        from .servo_speed import work_units
-        return work_units(settings=settings)
+        from .servo_speed import PAPER_SPEEDS, work_units
+        return work_units(options.get("speeds", PAPER_SPEEDS), settings)
     if name == "servo-convergence":
         from .servo_convergence import work_units
-    else:
-        from .thermal_compare import work_units
-    return work_units()
+        return work_units()
+    from .thermal_compare import work_units
+    return work_units(gyros)
 
 
 def run_study(
@@ -63,7 +64,8 @@ def run_study(
     seed : int
         Seed of the random generator.
     settings : ServoSettings, optional
-        Servo simulation settings (seed 000 studies).
+        Servo simulation settings (seed 000 studies; thermal-compare takes ``sample_rate``
+        and ``noise`` as options).
     progress : callable, optional
         ``progress(advance, label)`` after each unit of work.
     **options
@@ -73,6 +75,8 @@ def run_study(
     for label, value in (("gyros", gyros), ("reps", reps)):
         if value is not None and (int(value) != value or value < 1):
             raise InputError(f"--{label} must be a positive integer, got {value!r}")
+    if name == "servo-convergence" and gyros is not None:
+        raise InputError("servo-convergence calibrates seed 000 Table I's three fixed gyros; --gyros does not apply")
     sizes = {key: int(v) for key, v in (("gyros", gyros), ("reps", reps)) if v is not None}
     common = dict(seed=seed, progress=progress, **options)
     out = Path(out)
@@ -88,4 +92,4 @@ def run_study(
         from .servo_speed import run
         return run(out, **sizes, **common)
     from .servo_convergence import run
-    return run(out, **{k: v for k, v in sizes.items() if k == "reps"}, **common)
+    return run(out, **sizes, **common)

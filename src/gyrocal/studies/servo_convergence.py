@@ -30,7 +30,7 @@ def run(
     *,
     reps: int = 1000,
     seed: int = 0,
-    noise: float = 0.035,
+    noise: float | None = None,
     settings: ServoSettings = ServoSettings(),
     progress: Progress | None = None,
     plot: bool = True,
@@ -41,9 +41,11 @@ def run(
     ----------
     reps : int
         Extra calibrations per case used to count iterations.
-    noise : float
-        Per-sample white noise [rad/s] (the paper's lower level).
+    noise : float, optional
+        Per-sample white noise [rad/s]; default the first of ``settings.noise_levels``
+        (the paper's lower level).
     """
+    noise = settings.noise_levels[0] if noise is None else noise
     rng = np.random.default_rng(seed)
     estimator = Algorithm1()
     rows, count_rows, cases = [], [], {}

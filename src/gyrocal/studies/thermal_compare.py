@@ -23,6 +23,10 @@ from ._tables import write_table
 #: Test temperatures [degC]: between the Table 1 nodes, plus the traditional 25 degC.
 TEST_TEMPS = (-35.0, -25.0, -15.0, -5.0, 5.0, 15.0, 25.0, 35.0, 45.0)
 METHODS = ("uncompensated", "traditional", "lagrange", "smooth")
+GYROS = 3
+SAMPLE_RATE = 100.0  # [Hz]
+NOISE = 0.005  # per-sample white noise [rad/s]
+SETTLE = 2.0  # time dropped at each step start [s], in calibration and test alike
 
 
 def _gyro(rng: np.random.Generator, noise: float):
@@ -41,17 +45,17 @@ def _gyro(rng: np.random.Generator, noise: float):
 def run(
     out: Path,
     *,
-    gyros: int = 3,
+    gyros: int = GYROS,
     reps: int = 1,
     seed: int = 0,
     step_duration: float = 10.0,
-    sample_rate: float = 100.0,
-    noise: float = 0.005,
+    sample_rate: float = SAMPLE_RATE,
+    noise: float = NOISE,
     test_temps: Sequence[float] = TEST_TEMPS,
     progress: Progress | None = None,
     plot: bool = True,
 ) -> StudyOutput:
-    """Run the study; write ``table34.{csv,md}``, ``by_temperature.{csv,md}`` and ``thermal.png``.
+    """Run the study; write ``table34.{csv,md}``, ``by_temperature.{csv,md}`` and ``thermal.png`` (noise floor dashed).
 
     Parameters
     ----------
@@ -78,10 +82,11 @@ def run(
         gyro = _gyro(rng, noise)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ThermalWarning)
-            cal, _ = calibrate_thermal([simulate_turntable(gyro, cal_protocol, sample_rate=sample_rate, rng=rng)])
+            cal, _ = calibrate_thermal([simulate_turntable(gyro, cal_protocol, sample_rate=sample_rate, rng=rng)],
+                                       settle=SETTLE)
             for _ in range(reps):
                 test = simulate_turntable(gyro, test_protocol, sample_rate=sample_rate, rng=rng)
-                evaluations.append(evaluate(cal, [test]))
+                evaluations.append(evaluate(cal, [test], settle=SETTLE))
         if progress:
             progress(1, f"gyro {g + 1}/{gyros}")
     from ..thermal.session import Steps
@@ -97,20 +102,30 @@ def run(
     by_temp = merged.by_temperature("deg/s")
     files += write_table(out / "by_temperature", ["temp [degC]"] + [f"{m} rms [deg/s]" for m in METHODS],
                          [[r["temp"], *[r[f"{m}_rms"] for m in METHODS]] for r in by_temp])
+    floor = step_noise_floor(noise, sample_rate, step_duration)
     if plot:
         from ..plotting._mpl import save_figure
         from ..plotting.studies import rms_by_temperature_figure
 
         fig = rms_by_temperature_figure([r["temp"] for r in by_temp],
-                                        {m: [r[f"{m}_rms"] for r in by_temp] for m in METHODS},
+                                        {m: [r[f"{m}_rms"] for r in by_temp] for m in METHODS}, floor=floor,
                                         title=f"seed 001 Tables 3-4 analogue ({gyros} simulated gyros)")
         save_figure(fig, out / "thermal.png")
         files.append(out / "thermal.png")
     total = {m: float(np.sqrt(np.mean(merged.errors[m] ** 2)) * 180 / np.pi) for m in METHODS}
-    text = "RMS step error [deg/s]: " + ", ".join(f"{m} {v:.3g}" for m, v in total.items())
+    text = ("RMS step error [deg/s]: " + ", ".join(f"{m} {v:.3g}" for m, v in total.items())
+            + f"; noise floor of a step mean {floor:.3g}")
     return StudyOutput("thermal-compare", tuple(files), text)
 
 
-def work_units(gyros: int = 3) -> int:
-    """Progress units this study reports."""
-    return gyros
+def step_noise_floor(noise: float, sample_rate: float, step_duration: float) -> float:
+    """Std of a test step's mean [deg/s]: no compensation can beat it (white noise only).
+
+    ``noise`` [rad/s] per sample, averaged over the samples left after :data:`SETTLE`.
+    """
+    return float(np.degrees(noise) / np.sqrt(max(round((step_duration - SETTLE) * sample_rate), 1)))
+
+
+def work_units(gyros: int | None = None) -> int:
+    """Progress units this study reports for `gyros` (default :data:`GYROS`)."""
+    return GYROS if gyros is None else gyros
