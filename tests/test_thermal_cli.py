@@ -103,3 +103,16 @@ def test_report_outside_the_calibrated_range_names_the_flag(files, tmp_path, cap
     assert run(["thermal-report", str(out), str(files["test"]), "-o", str(tmp_path / "r"), "--no-figures",
                 "--settle", "1", "--full-scale", "300"]) == 2
     assert "-15.00 degC; pass --out-of-range 'clamp'" in capsys.readouterr().err
+
+
+def test_thermal_output_is_replaced_only_when_the_same_or_forced(files, tmp_path, capsys):
+    out = tmp_path / "thermal.json"
+    args = ["thermal", str(files["session"]), "--units", "deg/s", "-o", str(out), "--full-scale", "300", "--settle", "1"]
+    assert run(args) == 0 and run(args) == 0  # the same table again
+    before = out.read_text()
+    capsys.readouterr()
+    assert run(args + ["--ref-temp", "0"]) == 2
+    assert "different calibration" in capsys.readouterr().err and out.read_text() == before
+    assert run(args + ["--ref-temp", "0", "--force"]) == 0
+    assert run(["thermal", str(files["session"]), "--units", "deg/s", "-o", str(files["session"]), "--force"]) == 2
+    assert "also an input" in capsys.readouterr().err

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import Callable, Iterable
 
@@ -56,5 +57,20 @@ def same_text(text: str) -> Callable[[Path], bool]:
             return path.read_text(encoding="utf-8") == text
         except (OSError, UnicodeDecodeError):
             return False
+
+    return test
+
+
+def same_document(doc: dict) -> Callable[[Path], bool]:
+    """A `replaceable` test: the file is JSON holding `doc` (apart from which gyrocal wrote it)."""
+
+    def test(path: Path) -> bool:
+        try:
+            old = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+            return False
+        drop = ("created_by",)
+        return isinstance(old, dict) and (
+            {k: v for k, v in old.items() if k not in drop} == {k: v for k, v in doc.items() if k not in drop})
 
     return test

@@ -25,7 +25,7 @@ from ..errors import GyrocalError, InputError
 from ..segmentation import describe_found
 from ..units import from_rad_s, parse_input_unit, parse_rate_unit, unit_factor
 from ..windows import Window
-from ._outputs import check_output, same_text, starts_with
+from ._outputs import check_output, same_document, same_text, starts_with
 from .app import app, console, warn, warnings_as_lines
 from .thermal_cmds import OutOfRangePolicy as OutOfRange
 
@@ -153,17 +153,6 @@ def _example_paths() -> tuple[Path, Path]:
     return Path(str(data / EXAMPLE)), Path(str(data / EXAMPLE_TRUTH))
 
 
-def _same_calibration(path: Path, doc: dict) -> bool:
-    try:
-        old = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
-        return False
-    if not isinstance(old, dict):
-        return False
-    strip = ("created_by",)
-    return {k: v for k, v in old.items() if k not in strip} == {k: v for k, v in doc.items() if k not in strip}
-
-
 def _params_table(run, truth: Calibration | None = None):
     """Rich tables: seed 000 k, b in user units with 1-sigma (and the truth, for the example),
     and the canonical correction."""
@@ -280,7 +269,7 @@ def calibrate(
     cal = run.calibration
     doc = to_document(cal)
     inputs = (Path(recording), windows)
-    check_output(output, inputs=inputs, force=force, replaceable=lambda p: _same_calibration(p, doc),
+    check_output(output, inputs=inputs, force=force, replaceable=same_document(doc),
                  holds="a different calibration or another file")
     check_output(plot, flag="--plot", inputs=inputs + (output,), force=True)
     # files first: a reader that closes stdout early (| head) must not cost the outputs

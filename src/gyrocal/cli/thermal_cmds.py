@@ -14,6 +14,7 @@ import numpy as np
 import typer
 
 from ..units import parse_input_unit, parse_rate_unit, unit_factor
+from ._outputs import check_output, same_document
 from .app import app, console, fail, warnings_as_lines
 
 __all__ = ["thermal", "thermal_report"]
@@ -80,9 +81,12 @@ def thermal(
     max_order: Annotated[int, typer.Option("--max-order", help="Highest polynomial order of the smooth model.")] = 3,
     temp_tau: Annotated[float, typer.Option(
         "--temp-tau", help="Time constant for smoothing per-sample temperature when compensating (s).")] = 20.0,
+    force: Annotated[bool, typer.Option("--force", help="Replace an -o file that holds a different calibration.")]
+    = False,
 ) -> None:
     """Fit a temperature table (seed 001) from a turntable session."""
     from ..thermal import calibrate_thermal, save_thermal
+    from ..thermal.model import to_document
 
     in_u, out_u = _units(units, output_units, sensitivity)
     with warnings_as_lines():
@@ -91,6 +95,8 @@ def thermal(
                                      full_scale=_full_scale(full_scale, units, out_u, sensitivity),
                                      temp_tolerance=temp_tolerance, reference_temp=ref_temp, max_order=max_order,
                                      temp_tau=temp_tau, names=names)
+    check_output(output, inputs=(session,), force=force, replaceable=same_document(to_document(cal)),
+                 holds="a different calibration or another file")
     save_thermal(cal, output)
     _print_table(cal, fit)
     console.print(f"wrote {output}")
