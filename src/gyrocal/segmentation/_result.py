@@ -94,9 +94,12 @@ class Segmentation:
                         + (" and no static window" if static_allowed else ""))
         if len(rot) < min_rotations:
             need.append(f"{len(rot)} rotation(s) where the method needs {min_rotations}")
+        short = any(why.startswith("no plateau") for _, why in self.ignored)
         raise SegmentationError(
             f"found {describe_found(self.windows, self.ignored)}: {'; '.join(need)}. The method needs a "
             "rotation about every axis, in both senses" + (" or with a static window" if static_allowed else "")
+            + ("; turns too short to hold a steady speed: calibrate with the angle reference (--angle 360)"
+               if short else "")
             + "; check --speed/--angle and the units, or give the windows with --windows"
         )
 
