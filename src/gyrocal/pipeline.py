@@ -180,9 +180,11 @@ def _gap_times(rec: Recording, w: Window) -> np.ndarray | None:
 
 
 def _observe(rec: Recording, w: Window, reference: str, speed) -> Observation:
-    # Column-major windows make the per-axis reductions contiguous (about 4x faster than C order);
-    # copying only the windows used is cheaper than converting the whole log.
-    samples = np.asfortranarray(rec.gyro[w.start:w.stop])
+    # Column-major windows make the per-axis reductions contiguous (about 4x faster than C order):
+    # readers give column-major recordings; others are copied window by window, not whole.
+    samples = rec.gyro[w.start:w.stop]
+    if not samples.flags.f_contiguous and not rec.gyro.flags.f_contiguous:
+        samples = np.asfortranarray(samples)
     fs = rec.sample_rate
     if w.kind == "static":
         return observe(samples, fs, "static")

@@ -12,7 +12,7 @@ from ..errors import InputError, NonFiniteInputError, SaturationError, UnitError
 from ..recording import Recording
 from ..units import parse_input_unit, parse_rate_unit, unit_factor
 from ._columns import NUMERIC
-from .saturation import find_saturation
+from .saturation import find_saturation, stuck_runs
 
 SaturationPolicy = Literal["error", "drop", "ignore"]
 
@@ -27,9 +27,9 @@ MAX_PLAUSIBLE_NOISE_RAD_S = 0.3
 NOISE_SAMPLES = 100_000
 
 
-def _check_finite(data: dict, source: str) -> None:
+def _check_finite(data: dict, source: str, known_finite: tuple[str, ...] = ()) -> None:
     # a sum is one fast pass and is finite when every term is (bar overflow, rechecked below)
-    if all(np.isfinite(np.sum(data[c])) for c in NUMERIC if c in data):
+    if all(np.isfinite(np.sum(data[c])) for c in NUMERIC if c in data and c not in known_finite):
         return
     bad = None
     for c in NUMERIC:
@@ -79,8 +79,7 @@ def _noise(raw: np.ndarray) -> float:
     return float(np.min(np.median(d, axis=0))) / (0.6745 * math.sqrt(2.0))
 
 
-def _check_units(raw: np.ndarray, unit: str, sensitivity: float | None, source: str) -> None:
-    peak = max(float(raw.max()), -float(raw.min())) if raw.size else 0.0
+def _check_units(raw: np.ndarray, unit: str, sensitivity: float | None, source: str, peak: float) -> None:
     if unit == "counts":
         if not np.array_equal(raw, np.round(raw)):
             i = int(np.argmax((raw != np.round(raw)).any(axis=1)))
@@ -106,13 +105,13 @@ def _check_units(raw: np.ndarray, unit: str, sensitivity: float | None, source: 
         )
 
 
-def _check_saturation(raw, full_scale, policy: str, source: str) -> np.ndarray | None:
-    """Rows to keep (None: all)."""
+def _check_saturation(raw, full_scale, policy: str, source: str, extremes) -> np.ndarray | None:
+    """Rows to keep (None: all); `extremes` are each axis's (max, min)."""
     if policy not in ("error", "drop", "ignore"):
         raise InputError(f"saturation={policy!r} is not accepted; use 'error', 'drop' or 'ignore'")
     if policy == "ignore":
         return None
-    mask = find_saturation(raw, full_scale)
+    mask = find_saturation(raw, full_scale) if full_scale is not None else stuck_runs(raw, *extremes)
     if not mask.any():
         return None
     if policy == "drop":
@@ -167,8 +166,11 @@ def build_recording(
     n = len(data["gx"])
     if n < 2:
         raise InputError(f"{source}: {'no data rows' if n == 0 else 'a single data row'}; a recording needs at least two samples")
-    _check_finite(data, source)
     raw = _rates_block(data["gx"], data["gy"], data["gz"])
+    # one pass for each axis's extremes serves the finiteness, unit and saturation checks (NaN propagates)
+    hi, lo = raw.max(axis=0), raw.min(axis=0)
+    rates_finite = bool(np.isfinite(hi).all() and np.isfinite(lo).all())
+    _check_finite(data, source, known_finite=("gx", "gy", "gz") if rates_finite else ())
     if "t" in data:
         t, has_time = np.asarray(data["t"], dtype=float), True  # a time column wins over sample_rate
         fs = _check_time(t, source)
@@ -181,8 +183,8 @@ def build_recording(
             "(sample_rate=HZ, CLI --sample-rate HZ) or map the time column (--columns t=NAME)"
         )
     if check_units:
-        _check_units(raw, unit, sensitivity, source)
-    keep = _check_saturation(raw, full_scale, saturation, source)
+        _check_units(raw, unit, sensitivity, source, peak=max(float(hi.max()), -float(lo.min())))
+    keep = _check_saturation(raw, full_scale, saturation, source, (hi, lo))
     if unit == "counts":
         factor = 1.0 if sensitivity is None else unit_factor(out_unit) / sensitivity
         table_factor = unit_factor(out_unit)  # a table's rate is physical, never counts

@@ -58,20 +58,25 @@ def find_saturation(gyro, full_scale: float | None = None, *, min_run: int = MIN
         return np.abs(g) >= positive("full_scale", full_scale)
     if int(min_run) < 1:
         raise InputError(f"min_run must be >= 1, got {min_run!r}")
+    if len(g) == 0:
+        return np.zeros(g.shape, dtype=bool)
+    return stuck_runs(g, g.max(axis=0), g.min(axis=0), int(min_run))
+
+
+def stuck_runs(g: np.ndarray, hi: np.ndarray, lo: np.ndarray, min_run: int = MIN_RUN) -> np.ndarray:
+    """:func:`find_saturation` without a full scale, given each axis's maximum and minimum (3,)."""
     mask = np.zeros(g.shape, dtype=bool)
     for j in range(3):
-        col = g[:, j]  # column by column: numpy reduces a strided 1-D view far faster than axis=0 of (N, 3)
-        if len(col) == 0:
-            continue
+        col = g[:, j]
         median = None
         # each extreme on its own: a run stuck at +32767 counts even when one sample reads -32768
-        for level in {col.max(), col.min()}:  # a set: one pass for a constant axis
+        for level in {hi[j], lo[j]}:  # a set: one pass for a constant axis
             if not np.isfinite(level) or level == 0:
                 continue
             stuck = col == level
             if np.count_nonzero(stuck) < min_run:  # the common case: no pile-up at this extreme
                 continue
-            runs = _long_runs(stuck, int(min_run))
+            runs = _long_runs(stuck, min_run)
             if runs.any():
                 median = np.median(np.abs(col)) if median is None else median  # a sort: only when needed
                 if abs(level) > 2.0 * median:
