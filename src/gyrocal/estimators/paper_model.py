@@ -64,12 +64,15 @@ def kb_covariance(beta: np.ndarray, obs: ObservationSet) -> tuple[np.ndarray, np
     s2 = nv[:, None, :]
     row_var = np.sum(s2 * ((2 * b1 * obs.mean + b2) ** 2 + 2 * b1**2 * s2), axis=-1) / obs.count
     J = np.concatenate([obs.mean_sq, obs.mean], axis=-1) + gamma_gradient(beta)[:, None, :]
-    Hinv = np.linalg.inv(np.einsum("bmi,bmj->bij", J, J))
-    cov_beta = Hinv @ np.einsum("bmi,bm,bmj->bij", J, row_var, J) @ Hinv
-    # k = sqrt(beta_1..3), b = beta_4..6 / (2 beta_1..3)
-    G = np.zeros_like(cov_beta)
-    j = np.arange(3)
-    G[:, j, j] = 1 / (2 * np.sqrt(beta[:, :3]))
-    G[:, j + 3, j] = -beta[:, 3:] / (2 * beta[:, :3] ** 2)
-    G[:, j + 3, j + 3] = 1 / (2 * beta[:, :3])
-    return G @ cov_beta @ G.transpose(0, 2, 1), nv
+    # d beta = A e with e the rows' unit-variance errors: A = J^-1 sqrt(row_var) (square J), else H^-1 J^T sqrt(..)
+    if J.shape[1] == J.shape[2]:
+        A = np.linalg.inv(J)
+    else:
+        Jt = J.transpose(0, 2, 1)
+        A = np.linalg.solve(np.einsum("bmi,bmj->bij", J, J), Jt)
+    A *= np.sqrt(row_var)[:, None, :]
+    # to (k, b): k = sqrt(beta_1..3), b = beta_4..6 / (2 beta_1..3); rows of A are d beta per error
+    L = np.empty_like(A)
+    L[:, :3] = A[:, :3] / (2 * np.sqrt(beta[:, :3]))[..., None]
+    L[:, 3:] = (A[:, 3:] - (beta[:, 3:] / beta[:, :3])[..., None] * A[:, :3]) / (2 * beta[:, :3])[..., None]
+    return np.einsum("bik,bjk->bij", L, L), nv
