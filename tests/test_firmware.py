@@ -442,3 +442,18 @@ def test_missing_compiler_is_a_missing_dependency(monkeypatch, tmp_path):
     assert firmware.find_c_compiler() is None
     with pytest.raises(gyrocal.errors.MissingDependencyError, match="no C compiler found"):
         firmware.build_library(tmp_path)
+
+
+def test_temperature_filter_matches_the_forward_low_pass_and_removes_the_steps(clib):
+    """Readings in whole degrees through gyrocal_temp_filter: scipy's first-order filter, to float32."""
+    from scipy.signal import lfilter
+
+    fs, tau = 100.0, 20.0
+    t = np.arange(0, 600, 1 / fs)
+    reading = np.round(20.0 + 0.02 * t)  # a slow soak read in whole degrees: 12 steps of 1 degC
+    out = clib.temp_filter(reading, fs, tau)
+    a = np.exp(-1 / (fs * tau))
+    ref, _ = lfilter([1 - a], [1, -a], reading, zi=[a * reading[0]])
+    assert np.max(np.abs(out - ref)) < 1e-4  # float32 state over 60,000 steps near 30 degC
+    # a 1 degC step of the reading moves the filtered temperature by at most 2 alpha (lag < 1 degC) per sample
+    assert np.max(np.abs(np.diff(out))) < 2 * (1 - a) < 0.01

@@ -26,7 +26,7 @@ import numpy as np
 
 from . import __version__
 from ._atomic import atomic_path
-from ._validation import finite_array
+from ._validation import finite_array, positive
 from .calibration import Calibration
 from .errors import (
     ConvergenceError,
@@ -183,8 +183,9 @@ def thermal_c_header(tc) -> str:
     if tau:
         comment += [
             f"Temperature: gyrocal apply low-passes the temp readings (time constant {tau:g} s) before the lookup,",
-            "  so 1 degC steps do not make the output jump; feed temp_degC through a first-order low-pass",
-            "  with GYROCAL_THERMAL_TEMP_TAU_S on the device too.",
+            "  so 1 degC steps do not make the output jump. On the device do the same, causally:",
+            "  alpha = 1 - expf(-dt / GYROCAL_THERMAL_TEMP_TAU_S) once, state = first reading, then per sample",
+            "  temp_degC = gyrocal_temp_filter(&state, reading, alpha).",
         ]
     rows = ",\n".join(f"    {_c_vector(row)}" for row in kg)
     body = (
@@ -291,6 +292,7 @@ _SIGNATURES = {
     "gyrocal_correct": (None, [_P(_Affine), _P(ctypes.c_float), _P(ctypes.c_float)]),
     "gyrocal_thermal_correct": (ctypes.c_int, [_P(_Thermal), ctypes.c_float, _P(ctypes.c_float), ctypes.c_uint,
                                                _P(ctypes.c_float)]),
+    "gyrocal_temp_filter": (ctypes.c_float, [_P(ctypes.c_float), ctypes.c_float, ctypes.c_float]),
     "gyrocal_accum_reset": (None, [_P(_Accum)]),
     "gyrocal_accum_add": (None, [_P(_Accum), _P(ctypes.c_float)]),
     "gyrocal_accum_finish": (ctypes.c_int, [_P(_Accum), ctypes.c_float, _P(_Obs)]),
@@ -357,6 +359,13 @@ class CLibrary:
                                                       _ptr(out[i]))
             self._check(status, f"thermal correction at {float(tt[i]):g} degC")
         return out
+
+    def temp_filter(self, temp, sample_rate: float, tau: float) -> np.ndarray:
+        """``gyrocal_temp_filter`` over readings `temp` (N,) [degC], starting from the first."""
+        t = _f32("temp", temp, ())
+        alpha = -np.expm1(-1.0 / (positive("sample_rate", sample_rate) * positive("tau", tau)))
+        state = ctypes.c_float(t[0] if len(t) else 0.0)
+        return np.array([self.dll.gyrocal_temp_filter(ctypes.byref(state), float(x), alpha) for x in t], np.float32)
 
     def accumulate(self, samples, rate: float = 1.0) -> tuple[np.ndarray, np.ndarray, int]:
         """Stream `samples` (N, 3) through the accumulator; ``(mean, mean_sq, count)``."""

@@ -96,6 +96,12 @@ void gyrocal_scale_bias_to_affine(const gyrocal_scale_bias_t *sb, gyrocal_affine
 /* Position in K (seed 001, eq. 11) of the Kg elements 0..8 (eq. 14), as row * 3 + column. */
 static const uint8_t KG_SLOT[9] = {0, 4, 8, 1, 2, 3, 5, 6, 7};
 
+float gyrocal_temp_filter(float *state, float temp, float alpha)
+{
+    *state += alpha * (temp - *state);
+    return *state;
+}
+
 gyrocal_status_t gyrocal_thermal_correct(const gyrocal_thermal_t *table, float temp, const float raw[3],
                                          unsigned flags, float out[3])
 {

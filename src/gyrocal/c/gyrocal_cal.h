@@ -102,6 +102,12 @@ void gyrocal_scale_bias_to_affine(const gyrocal_scale_bias_t *sb, gyrocal_affine
 gyrocal_status_t gyrocal_thermal_correct(const gyrocal_thermal_t *table, float temp, const float raw[3],
                                          unsigned flags, float out[3]);
 
+/* One step of a first-order low-pass of the temperature reading [degC] before gyrocal_thermal_correct,
+ * so that readings in whole degrees do not make the corrected output jump. alpha = 1 - expf(-dt / tau)
+ * for sample interval dt and time constant tau (GYROCAL_THERMAL_TEMP_TAU_S in exported headers);
+ * set *state to the first reading before the first call. Returns the filtered temperature. */
+float gyrocal_temp_filter(float *state, float temp, float alpha);
+
 void gyrocal_accum_reset(gyrocal_accum_t *acc);
 void gyrocal_accum_add(gyrocal_accum_t *acc, const float sample[3]);
 /* Window mean and mean of squares; `rate` is stored as the observation's reference. */
