@@ -63,7 +63,8 @@ def test_simulate_turntable_flags_shape_the_session(tmp_path):
     assert 0.3 < np.std(first) < 0.8  # 0.5 degC noise, rounded to 1 degC: ~0.58
     settings = json.loads((tmp_path / "tt.truth.json").read_text())["settings"]
     assert settings["temps_degC"] == [-10.0, 30.0] and settings["rates_deg_s"] == [0.0, 20.0]
-    assert settings["step_duration_s"] == 1.0 and settings["temp_quantum_degC"] == 1.0
+    step_s = settings["step_duration_s"]  # the simulated step length, not a timing
+    assert step_s == 1.0 and settings["temp_quantum_degC"] == 1.0
     line = refused("simulate", "-o", out, "--protocol", "turntable", "--speed", "30")
     assert "--speed" in line and "turntable" in line
     assert "--temps" in refused("simulate", "-o", out, "--temps", "0,10")
