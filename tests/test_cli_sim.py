@@ -155,3 +155,17 @@ def test_help_keeps_the_units_written_in_brackets():
         assert text in out
     code, out, _ = invoke("calibrate", "--help")
     assert code == 0 and "[rad/s/sqrt(Hz)]" in out
+
+
+def test_outputs_replace_only_their_own_kind(tmp_path):
+    rec = tmp_path / "rec.csv"
+    assert invoke("simulate", "-o", rec, "--sample-rate", "20")[0] == 0
+    assert invoke("simulate", "-o", rec, "--sample-rate", "20", "--seed", "1")[0] == 0  # an earlier simulation
+    notes = tmp_path / "notes.csv"
+    notes.write_text("mine\n")
+    assert "--force" in refused("simulate", "-o", notes, "--sample-rate", "20")
+    assert notes.read_text() == "mine\n"
+    before = rec.read_text()
+    assert "also an input" in refused("noise", rec, "--units", "deg/s", "--json", rec)
+    assert rec.read_text() == before
+    assert "is a file; give a folder" in refused("study", "servo-normal", "-o", notes, "--gyros", "1", "--reps", "2")

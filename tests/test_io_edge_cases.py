@@ -143,3 +143,10 @@ def test_cli_refuses_each_in_one_line(tmp_path, rng):
     for name, (units, expected) in cases.items():
         line = refused("calibrate", tmp_path / name, "--units", units, "--speed", "60", "-o", tmp_path / "c.json")
         assert expected in line, line
+
+
+def test_numeric_header_names_are_a_header_when_mapped(tmp_path):
+    path = tmp_path / "frame.csv"
+    path.write_text("0,1,2,3\n" + "".join(f"{i / 100},{0.1 * i},0.2,0.3\n" for i in range(50)))
+    rec = read_recording(path, units="deg/s", columns="t=0,gx=1,gy=2,gz=3")
+    assert len(rec) == 50 and rec.sample_rate == pytest.approx(100.0)

@@ -92,3 +92,10 @@ def test_bad_nodes_are_refused(nodes):
 def test_unknown_policy_is_refused():
     with pytest.raises(InputError, match="out_of_range"):
         lagrange_weights(NODES, [0.0], out_of_range="wrap")
+
+
+def test_extrapolation_is_continuous_across_the_margin():
+    values = (NODES ** 2)[:, None]
+    with pytest.warns(ThermalRangeWarning, match="extrapolated"):
+        out = interpolate(NODES, values, [50.49, 50.51], out_of_range="extrapolate")
+    np.testing.assert_allclose(out[:, 0], [50.49 ** 2, 50.51 ** 2], rtol=1e-12)

@@ -4,19 +4,9 @@ from __future__ import annotations
 
 import contextlib
 import os
-import tempfile
+import secrets
 from pathlib import Path
 from typing import Iterator
-
-
-def _replaced_mode(target: Path) -> int:
-    """The existing file's mode, else 0666 less the process umask."""
-    try:
-        return target.stat().st_mode & 0o7777
-    except OSError:
-        umask = os.umask(0)
-        os.umask(umask)
-        return 0o666 & ~umask
 
 
 @contextlib.contextmanager
@@ -27,11 +17,17 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
     """
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp" + target.suffix, dir=target.parent)
-    os.close(fd)
-    tmp_path = Path(tmp)
-    # mkstemp makes the file private (0600); give it the mode a plain open() would have
-    os.chmod(tmp_path, _replaced_mode(target))
+    # Not mkstemp: it makes the file private (0600). O_EXCL keeps the name ours, and the kernel
+    # applies the umask to 0666 as for any new file; a replaced file keeps its own mode.
+    while True:
+        tmp_path = target.parent / f".{target.name}.{secrets.token_hex(4)}.tmp{target.suffix}"
+        try:
+            os.close(os.open(tmp_path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+            break
+        except FileExistsError:
+            continue
+    if target.exists():
+        os.chmod(tmp_path, target.stat().st_mode & 0o7777)
     try:
         yield tmp_path
         os.replace(tmp_path, target)

@@ -183,7 +183,8 @@ def thermal_c_header(tc) -> str:
     if tau:
         comment += [
             f"Temperature: gyrocal apply low-passes the temp readings (time constant {tau:g} s) before the lookup,",
-            "  so 1 degC steps do not make the output jump. On the device do the same, causally:",
+            "  so 1 degC steps do not make the output jump. apply filters forward and backward (no lag); a device",
+            "  can only filter forward, which lags by about that time constant:",
             "  alpha = 1 - expf(-dt / GYROCAL_THERMAL_TEMP_TAU_S) once, state = first reading, then per sample",
             "  temp_degC = gyrocal_temp_filter(&state, reading, alpha).",
         ]

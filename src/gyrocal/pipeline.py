@@ -125,7 +125,7 @@ _SPEED_SPREAD = 0.1
 
 def _require_constant_speed(samples: np.ndarray, w: Window, i: int) -> None:
     """Refuse a window with ramps: the speed reference holds only on the constant-speed part."""
-    tenths = np.linalg.norm([part.mean(axis=0) for part in np.array_split(samples, 10)], axis=1)
+    tenths = np.linalg.norm([part.mean(axis=0) for part in np.array_split(samples, min(10, len(samples)))], axis=1)
     middle = float(np.median(tenths))
     worst = float(min(tenths[0], tenths[-1]))
     if worst < (1 - _SPEED_SPREAD) * middle:
@@ -172,8 +172,11 @@ def _given_windows(rec: Recording, windows: Sequence[Window], reference: str, sp
 
 
 def _gap_times(rec: Recording, w: Window) -> np.ndarray | None:
-    """The window's sample times when the log dropped samples inside it, else None (evenly spaced)."""
-    if not rec.has_time or len(w) < 2:
+    """The window's sample times when the log dropped samples inside it, else None (evenly spaced).
+
+    Without a time column ``t`` is still exact: rows dropped for saturation leave their gaps in it.
+    """
+    if len(w) < 2:
         return None
     t = rec.t[w.start:w.stop]
     return t if (t[-1] - t[0]) * rec.sample_rate > len(w) - 0.5 else None
@@ -183,7 +186,7 @@ def _observe(rec: Recording, w: Window, reference: str, speed) -> Observation:
     # Column-major windows make the per-axis reductions contiguous (about 4x faster than C order):
     # readers give column-major recordings; others are copied window by window, not whole.
     samples = rec.gyro[w.start:w.stop]
-    if not samples.flags.f_contiguous and not rec.gyro.flags.f_contiguous:
+    if not rec.gyro.flags.f_contiguous:
         samples = np.asfortranarray(samples)
     fs = rec.sample_rate
     if w.kind == "static":

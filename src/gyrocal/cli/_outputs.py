@@ -17,15 +17,21 @@ def check_output(
     force: bool = False,
     replaceable: Callable[[Path], bool] = lambda _: False,
     holds: str = "something else",
+    folder: bool = False,
 ) -> None:
-    """Refuse an output that is an input, a folder, under a file, or an existing file that
-    `replaceable` does not accept (same content, or a regenerable gyrocal output) unless `force`."""
+    """Refuse an output that is an input, under a file, of the wrong kind (file or `folder`), or an
+    existing file that `replaceable` does not accept (same content, or a regenerable gyrocal output)
+    unless `force`. Writers of many files into a `folder` replace only their own names in it."""
     if path is None:
         return
     parent = next((p for p in path.parents if p.exists()), None)
     if parent is not None and not parent.is_dir():
         raise InputError(f"{flag} {path}: {parent} is a file, not a folder; choose another path")
     if not path.exists():
+        return
+    if folder:
+        if not path.is_dir():
+            raise InputError(f"{flag} {path} is a file; give a folder for the outputs")
         return
     if path.is_dir():
         raise InputError(f"{flag} {path} is a folder; give a file name inside it")
@@ -61,16 +67,23 @@ def same_text(text: str) -> Callable[[Path], bool]:
     return test
 
 
+def _json_object(path: Path) -> dict | None:
+    """The JSON object in `path`, or None when it holds anything else."""
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+        return None
+    return doc if isinstance(doc, dict) else None
+
+
 def same_document(doc: dict) -> Callable[[Path], bool]:
     """A `replaceable` test: the file is JSON holding `doc` (apart from which gyrocal wrote it)."""
+    drop = ("created_by",)
+    mine = {k: v for k, v in doc.items() if k not in drop}
+    return lambda path: (old := _json_object(path)) is not None and {
+        k: v for k, v in old.items() if k not in drop} == mine
 
-    def test(path: Path) -> bool:
-        try:
-            old = json.loads(path.read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError):
-            return False
-        drop = ("created_by",)
-        return isinstance(old, dict) and (
-            {k: v for k, v in old.items() if k not in drop} == {k: v for k, v in doc.items() if k not in drop})
 
-    return test
+def json_format(fmt: str) -> Callable[[Path], bool]:
+    """A `replaceable` test: the file is a JSON object of gyrocal format `fmt` (an earlier output)."""
+    return lambda path: (doc := _json_object(path)) is not None and doc.get("format") == fmt

@@ -7,7 +7,6 @@ and exit code 2; ``--debug`` shows the traceback instead.
 from __future__ import annotations
 
 import contextlib
-import os
 import sys
 import warnings
 
@@ -70,10 +69,6 @@ def run(argv: list[str] | None = None) -> int:
     """Run the CLI; map library, OS and usage errors to one line and exit code 2."""
     try:
         rv = app(args=argv, standalone_mode=False)
-    except BrokenPipeError:
-        # the reader of stdout went away (| head): not an error of ours; say nothing more
-        sys.stdout = open(os.devnull, "w")
-        return 141
     except (GyrocalError, OSError) as exc:
         if _state["debug"]:
             raise

@@ -15,10 +15,12 @@ import numpy as np
 import typer
 
 from ..errors import InputError
+from ._outputs import check_output, json_format, starts_with
 from .app import app, console
 from .calibrate_cmds import Columns, SampleRate, Units, _read
 
 TRUTH_FORMAT = "gyrocal.simulation-truth"
+_SIMULATED = "gyrocal simulate"  # first words of a simulated recording: a later simulate may replace it
 
 
 class ProtocolName(str, Enum):
@@ -179,6 +181,8 @@ def simulate(
     sample_rate: Annotated[float, typer.Option("--sample-rate", help="Sampling rate [Hz].")] = 200.0,
     units: Annotated[str, typer.Option("--units", help="Unit of the written gyro columns.")] = "deg/s",
     seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
+    force: Annotated[bool, typer.Option("--force", help="Replace an -o file that gyrocal simulate did not write.")]
+    = False,
 ) -> None:
     """Simulate a recording (servo, hand, turntable or profile) with its truth sidecar."""
     from .._jsonfile import write_json
@@ -188,6 +192,10 @@ def simulate(
     from ..units import from_rad_s, parse_rate_unit
 
     _refuse_unused(ctx, _PROTOCOL_FLAGS, protocol.value, "--protocol")
+    truth_path = output.with_name(output.stem + ".truth.json")
+    check_output(output, inputs=(profile,), force=force, replaceable=starts_with(f"# {_SIMULATED}"))
+    check_output(truth_path, flag="truth file", inputs=(profile,), force=force,
+                 replaceable=json_format(TRUTH_FORMAT))
     unit = parse_rate_unit(units)
     rng = np.random.default_rng(seed)
     sd = _noise_std(noise, noise_density, sample_rate, 0.035 if protocol != ProtocolName.turntable else 0.005)
@@ -243,8 +251,7 @@ def simulate(
     if rec.table_rate is not None:
         columns["table_rate"] = from_rad_s(rec.table_rate, unit)
         columns["axis"] = rec.axis
-    write_csv(output, columns, header_comment=f"gyrocal simulate --protocol {protocol.value}; gyro in {unit}, t in s")
-    truth_path = output.with_name(output.stem + ".truth.json")
+    write_csv(output, columns, header_comment=f"{_SIMULATED} --protocol {protocol.value}; gyro in {unit}, t in s")
     write_json(truth_path, _truth_doc(protocol.value, model, settings, extra))
     console.print(f"wrote {output} ({len(rec)} samples, {len(rec) / sample_rate:.1f} s, {unit}) and {truth_path}")
 
@@ -257,11 +264,16 @@ def noise(
     sample_rate: SampleRate = None,
     plot: Annotated[Optional[Path], typer.Option("--plot", help="Allan deviation plot (.png, .pdf, .svg).")] = None,
     json_out: Annotated[Optional[Path], typer.Option("--json", help="Write the noise figures as JSON.")] = None,
+    force: Annotated[bool, typer.Option("--force", help="Replace a --json file that is not a noise file.")]
+    = False,
 ) -> None:
     """Allan deviation of a static recording: angle random walk, bias instability, rate random walk."""
     from rich.table import Table
 
-    from ..noise import characterise, save_noise
+    from ..noise import FORMAT, characterise, save_noise
+
+    check_output(json_out, flag="--json", inputs=(recording,), force=force, replaceable=json_format(FORMAT))
+    check_output(plot, flag="--plot", inputs=(recording, json_out), force=True)
 
     if units is None:
         raise InputError("--units is required (rad/s or deg/s): the Allan deviation is reported in physical units")
@@ -397,6 +409,7 @@ def study(
     from ..studies import ServoSettings, run_study, study_units
 
     _refuse_unused(ctx, _STUDY_FLAGS, name.value, "study")
+    check_output(out, folder=True)
     options: dict = {}
     if methods is not None:
         options["methods"] = tuple(m.strip() for m in methods.split(",") if m.strip())

@@ -89,6 +89,7 @@ def thermal(
     from ..thermal.model import to_document
 
     in_u, out_u = _units(units, output_units, sensitivity)
+    check_output(output, inputs=(session,), force=True)  # what needs no fit: fail fast, before fitting
     with warnings_as_lines():
         recs, names = _read(session, units, columns, sample_rate, sensitivity, output_units)
         cal, fit = calibrate_thermal(recs, input_units=in_u, output_units=out_u, settle=settle,
@@ -108,9 +109,7 @@ def _print_table(cal, fit) -> None:
     from rich.table import Table
 
     user = cal.kg_user
-    c, d = unit_factor(cal.input_units), unit_factor(cal.output_units)
-    # 1-sigma in the table's units, scaled like kg_user (linear in kg); max over each group of terms.
-    std = np.concatenate([cal.std[:, :9] * (d / c), cal.std[:, 9:] / c], axis=1)
+    std = cal.to_user(cal.std)  # 1-sigma in the table's units; below, the largest of each group of terms
     groups = (std[:, :3].max(axis=1), std[:, 3:9].max(axis=1), std[:, 9:].max(axis=1))
     table = Table(title=escape(f"Kg per temperature (B, resid and sd B in [{cal.input_units}])"),
                   caption="sd K / sd mis / sd B: largest 1-sigma of Kxx..Kzz / of the 6 misalignments / of Bx..Bz",
@@ -151,6 +150,7 @@ def thermal_report(
     from ..thermal.evaluate import evaluate
     from ..thermal.report import write_report
 
+    check_output(output, inputs=(calibration, test), folder=True)
     cal = load_thermal(calibration)
     units = units or cal.input_units
     with warnings_as_lines():

@@ -27,3 +27,14 @@ def pooled_noise_var(mean: np.ndarray, noise_var: np.ndarray, count: np.ndarray,
     # An axis never seen off-rotation borrows the mean of the others.
     fallback = pooled.sum(axis=0) / np.maximum((total > 0).sum(axis=0), 1)
     return np.where(total > 0, pooled, fallback)
+
+
+def estimate_noise_var(obs) -> np.ndarray:
+    """Per-axis per-sample noise variance (B, 3) [reading units^2] of an ObservationSet, from its data.
+
+    Static windows are used when there are any. Otherwise each rotation window lends
+    its two non-rotating axes, whose first differences hold sensor noise but no
+    speed jitter (:func:`pooled_noise_var`).
+    """
+    obs = obs.as_batch()
+    return pooled_noise_var(obs.mean.transpose(1, 2, 0), obs.noise_var.transpose(1, 2, 0), obs.count, obs.static).T

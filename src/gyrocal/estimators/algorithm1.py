@@ -56,7 +56,7 @@ def algorithm1_batch(obs: ObservationSet, *, tol: float = 1e-6, max_iter: int = 
     require_converged(~active, iterations, "Algorithm 1")
     k, b = beta_to_kb(beta, "Algorithm 1")
     residuals = (X @ beta[..., None])[..., 0] + gamma(beta)[:, None] - Y
-    cov, nv = kb_covariance(beta, obs)
+    cov, nv = kb_covariance(beta, obs, X)
     return BatchFit(
         method="algorithm1", k=k, b=b, iterations=iterations, converged=~active, residuals=residuals,
         covariance=cov, noise_std=np.sqrt(nv), history=kb_history(np.stack(history)).transpose(1, 0, 2),

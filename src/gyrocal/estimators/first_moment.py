@@ -24,7 +24,7 @@ from ..observations import ObservationSet
 from ._checks import require_converged, require_count, require_every_axis, require_full_rank, require_positive_k2
 from ._exact6 import exact_six
 from ._lm import batched_lm
-from ._noise import pooled_noise_var
+from ._noise import estimate_noise_var
 from ._result import BatchFit, FitResult
 
 __all__ = ["FirstMoment", "estimate_noise_var", "first_moment_batch", "residuals_and_jacobian", "sandwich_covariance"]
@@ -64,17 +64,6 @@ def residuals_and_jacobian(p: np.ndarray, obs: ObservationSet) -> tuple[np.ndarr
         np.concatenate([J_rot, J_sta.reshape(B, -1, 6)], axis=1),
         np.concatenate([S_rot, S_sta.reshape(B, -1, 3)], axis=1),
     )
-
-
-def estimate_noise_var(obs: ObservationSet) -> np.ndarray:
-    """Per-axis per-sample noise variance (B, 3) [reading units^2], from the data.
-
-    Static windows are used when there are any. Otherwise each rotation window lends
-    its two non-rotating axes, whose first differences hold sensor noise but no
-    speed jitter (:func:`gyrocal.estimators._noise.pooled_noise_var`).
-    """
-    obs = obs.as_batch()
-    return pooled_noise_var(obs.mean.transpose(1, 2, 0), obs.noise_var.transpose(1, 2, 0), obs.count, obs.static).T
 
 
 def sandwich_covariance(J: np.ndarray, S: np.ndarray, noise_var: np.ndarray) -> np.ndarray:

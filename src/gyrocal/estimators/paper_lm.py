@@ -31,7 +31,7 @@ def paper_lm_batch(obs: ObservationSet, *, max_iter: int = 100) -> BatchFit:
     beta, iterations, converged, residuals, history = batched_lm(fun, beta0, max_iter=max_iter)
     require_converged(converged, iterations, "Levenberg-Marquardt")
     k, b = beta_to_kb(beta, "Levenberg-Marquardt")
-    cov, nv = kb_covariance(beta, obs)
+    cov, nv = kb_covariance(beta, obs, X)
     return BatchFit(
         method="lm", k=k, b=b, iterations=iterations, converged=converged, residuals=residuals,
         covariance=cov, noise_std=np.sqrt(nv), history=kb_history(history),

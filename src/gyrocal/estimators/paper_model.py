@@ -10,7 +10,7 @@ import numpy as np
 
 from ..observations import ObservationSet
 from ._checks import require_count, require_every_axis, require_full_rank, require_positive_k2
-from ._noise import pooled_noise_var
+from ._noise import estimate_noise_var
 
 BETA_NAMES = ("beta1", "beta2", "beta3", "beta4", "beta5", "beta6")
 
@@ -48,7 +48,7 @@ def gamma_gradient(beta: np.ndarray) -> np.ndarray:
     return np.concatenate([-beta[:, 3:] ** 2 / (4 * beta[:, :3] ** 2), beta[:, 3:] / (2 * beta[:, :3])], axis=1)
 
 
-def kb_covariance(beta: np.ndarray, obs: ObservationSet) -> tuple[np.ndarray, np.ndarray]:
+def kb_covariance(beta: np.ndarray, obs: ObservationSet, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Covariance (B, 6, 6) of ``(k, b)`` from the regression, and the noise variance (B, 3) used.
 
     White noise of variance ``s_j^2`` per sample moves a window's ``mean m_j`` by
@@ -59,11 +59,11 @@ def kb_covariance(beta: np.ndarray, obs: ObservationSet) -> tuple[np.ndarray, np
     the spread over noise draws; the bias of the mean-of-squares form (SPEC) comes on top.
     """
     obs = obs.as_batch()
-    nv = pooled_noise_var(obs.mean.transpose(1, 2, 0), obs.noise_var.transpose(1, 2, 0), obs.count, obs.static).T
+    nv = estimate_noise_var(obs)
     b1, b2 = beta[:, None, :3], beta[:, None, 3:]
     s2 = nv[:, None, :]
     row_var = np.sum(s2 * ((2 * b1 * obs.mean + b2) ** 2 + 2 * b1**2 * s2), axis=-1) / obs.count
-    J = np.concatenate([obs.mean_sq, obs.mean], axis=-1) + gamma_gradient(beta)[:, None, :]
+    J = X + gamma_gradient(beta)[:, None, :]  # X: the regressors (B, n, 6) of :func:`regressors`
     # d beta = A e with e the rows' unit-variance errors: A = J^-1 sqrt(row_var) (square J), else H^-1 J^T sqrt(..)
     if J.shape[1] == J.shape[2]:
         A = np.linalg.inv(J)

@@ -21,7 +21,8 @@ MAX_PLAUSIBLE_RAD_S = math.radians(2000.0)
 MAX_PLAUSIBLE_DEG_S = 5000.0
 #: MEMS gyros sample at 0.5 Hz-100 kHz; a time step outside that is a time column not in seconds.
 MIN_SAMPLE_RATE, MAX_SAMPLE_RATE = 0.5, 100e3
-#: Per-sample noise [rad/s] above any MEMS gyro's (about 0.01 typical): deg/s data declared as rad/s.
+#: Per-sample noise [rad/s] above any MEMS gyro's (0.001-0.05 typical): deg/s data declared as rad/s.
+#: It catches deg/s logs whose noise is at least 0.3 deg/s per sample; quieter ones need the peak test.
 MAX_PLAUSIBLE_NOISE_RAD_S = 0.3
 #: Samples the noise estimate looks at: enough for a robust median, bounded on long logs.
 NOISE_SAMPLES = 100_000
@@ -95,7 +96,7 @@ def _check_units(raw: np.ndarray, unit: str, sensitivity: float | None, source: 
     elif unit == "rad/s" and (noise := _noise(raw)) > MAX_PLAUSIBLE_NOISE_RAD_S:
         # slow turns in deg/s stay under the peak test, but their noise is 57 times too large
         raise UnitError(
-            f"{source}: the per-sample noise is {noise:.3g} rad/s, far above any MEMS gyro's (about 0.01); "
+            f"{source}: the per-sample noise is {noise:.3g} rad/s, far above any MEMS gyro's (0.001-0.05); "
             "the data are almost surely in deg/s: use --units deg/s (or --no-unit-check)"
         )
     elif unit == "deg/s" and peak > MAX_PLAUSIBLE_DEG_S and np.array_equal(raw, np.round(raw)):
@@ -140,7 +141,7 @@ def _rates_block(gx, gy, gz) -> np.ndarray:
         and [c.ctypes.data - base.ctypes.data for c in (gx, gy, gz)] == [0, 8 * len(gx), 16 * len(gx)]
     ):
         return base.T
-    return np.stack([gx, gy, gz]).astype(float, copy=False).T
+    return np.array([gx, gy, gz], dtype=float).T
 
 
 def build_recording(

@@ -95,7 +95,7 @@ def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool
     lines, encoding = _head(path)
     h, delimiter = sniff(lines, path.name)
     names = _split(lines[h], delimiter)
-    if all(_is_number(n) for n in names):
+    if not columns and all(_is_number(n) for n in names):  # mapped numeric names are a real header
         sep = delimiter or " "
         raise InputError(
             f"{path.name}: the first line ({lines[h][:40].strip()!r}) is data, not a header; add a header row "

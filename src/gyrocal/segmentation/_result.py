@@ -16,6 +16,9 @@ __all__ = ["Segmentation", "describe_found"]
 
 Reference = Literal["speed", "angle", "file"]
 
+#: Start of the reason given to a turn without a steady-speed stretch (speed reference).
+NO_PLATEAU = "no plateau"
+
 
 def _turn_label(w: Window) -> str:
     return f"{'+' if w.sign >= 0 else '-'}{w.axis}" if w.axis else "?"
@@ -94,7 +97,7 @@ class Segmentation:
                         + (" and no static window" if static_allowed else ""))
         if len(rot) < min_rotations:
             need.append(f"{len(rot)} rotation(s) where the method needs {min_rotations}")
-        short = any(why.startswith("no plateau") for _, why in self.ignored)
+        short = any(why.startswith(NO_PLATEAU) for _, why in self.ignored)
         raise SegmentationError(
             f"found {describe_found(self.windows, self.ignored)}: {'; '.join(need)}. The method needs a "
             "rotation about every axis, in both senses" + (" or with a static window" if static_allowed else "")

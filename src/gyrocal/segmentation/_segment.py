@@ -23,7 +23,7 @@ from ..errors import InputError, SegmentationError
 from ..recording import Recording
 from ..windows import Window
 from ._motion import Motion, detect_motion, runs_of
-from ._result import Segmentation
+from ._result import NO_PLATEAU, Segmentation
 
 __all__ = ["segment"]
 
@@ -205,7 +205,7 @@ def _speed_turns(rec, mo: Motion, speed, speed_tol, plateau_tol, min_plateau):
     for i in np.setdiff1d(np.arange(len(runs)), owner).tolist():
         label = f"{'+' if sg[i] > 0 else '-'}{'xyz'[ax[i]]}"
         ignored.append((Window(int(s0[i]), int(s1[i]), "rotation", "xyz"[ax[i]], int(sg[i]), label=label),
-                        f"no plateau: no {min_plateau:g} s stretch within {100 * plateau_tol:.0f} % of a steady speed"))
+                        f"{NO_PLATEAU}: no {min_plateau:g} s stretch within {100 * plateau_tol:.0f} % of a steady speed"))
     return chosen, ignored, [tuple(r) for r in runs.tolist()]
 
 

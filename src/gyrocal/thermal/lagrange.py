@@ -47,16 +47,14 @@ def range_policy(nodes: np.ndarray, temp: np.ndarray, out_of_range: OutOfRange) 
     lo, hi = nodes[0], nodes[-1]
     outside = (temp < lo - RANGE_MARGIN) | (temp > hi + RANGE_MARGIN)
     if not outside.any():
-        return np.clip(temp, lo, hi)
+        return temp if out_of_range == "extrapolate" else np.clip(temp, lo, hi)
     worst = float(temp[outside][np.argmax(np.abs(temp[outside] - (lo + hi) / 2))])
     where = f"{int(outside.sum())} temperature reading(s) outside the calibrated range [{lo:g}, {hi:g}] degC, e.g. {worst:.2f} degC"
     if out_of_range == "refuse":
         raise OutOfRangeError(f"{where}; pass out_of_range='clamp' or 'extrapolate' to accept them")
     warnings.warn(f"{where}; {'clamped to the nearest end' if out_of_range == 'clamp' else 'extrapolated'}",
                   ThermalRangeWarning, stacklevel=3)
-    if out_of_range == "clamp":
-        return np.clip(temp, lo, hi)
-    return np.where(outside, temp, np.clip(temp, lo, hi))
+    return np.clip(temp, lo, hi) if out_of_range == "clamp" else temp
 
 
 def stencil(nodes: np.ndarray, temp: np.ndarray) -> np.ndarray:

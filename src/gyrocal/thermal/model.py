@@ -133,11 +133,16 @@ class ThermalCalibration:
         """Index of the point nearest to :attr:`reference_temp` (the traditional baseline)."""
         return int(np.argmin(np.abs(self.temps - self.reference_temp)))
 
+    def to_user(self, kg: np.ndarray) -> np.ndarray:
+        """Kg-ordered values (n, 12) in user units: K terms times output/input factor, B in input
+        units. Linear, so it serves Kg and its 1-sigma alike."""
+        c, d = unit_factor(self.input_units), unit_factor(self.output_units)
+        return np.concatenate([kg[:, :9] * (d / c), kg[:, 9:] / c], axis=1)
+
     @property
     def kg_user(self) -> np.ndarray:
-        """Kg (n, 12) in user units: K times output/input factor, B in input units (linear in kg)."""
-        c, d = unit_factor(self.input_units), unit_factor(self.output_units)
-        return np.concatenate([self.kg[:, :9] * (d / c), self.kg[:, 9:] / c], axis=1)
+        """Kg (n, 12) in user units (:meth:`to_user`)."""
+        return self.to_user(self.kg)
 
     @property
     def correction(self) -> tuple[np.ndarray, np.ndarray]:
