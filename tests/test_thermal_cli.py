@@ -45,7 +45,7 @@ def files(tmp_path_factory):
 def test_thermal_then_report(files, tmp_path, capsys, monkeypatch):
     from gyrocal.cli.app import console
 
-    monkeypatch.setattr(console, "_width", 100)
+    monkeypatch.setattr(console, "_width", 80)  # piped output: both tables must fit
     out = tmp_path / "thermal.json"
     assert run(["thermal", str(files["session"]), "--units", "deg/s", "-o", str(out), "--full-scale", "300",
                 "--settle", "1"]) == 0
@@ -58,7 +58,7 @@ def test_thermal_then_report(files, tmp_path, capsys, monkeypatch):
     assert "sd mis" in captured.out and "sd B" in captured.out
     for p in doc["points"]:
         std = np.array(p["std"])
-        row = next(line for line in captured.out.splitlines() if line.split()[:1] == [f"{p['temp']:.1f}"])
+        row = [line for line in captured.out.splitlines() if line.split()[:1] == [f"{p['temp']:.1f}"]][-1]
         assert row.split()[-3:] == [f"{v:.1e}" for v in (std[:3].max(), std[3:9].max(), np.degrees(std[9:]).max())]
     rep = tmp_path / "report"
     assert run(["thermal-report", str(out), str(files["test"]), "-o", str(rep), "--settle", "1",

@@ -111,18 +111,23 @@ def _print_table(cal, fit) -> None:
     user = cal.kg_user
     std = cal.to_user(cal.std)  # 1-sigma in the table's units; below, the largest of each group of terms
     groups = (std[:, :3].max(axis=1), std[:, 3:9].max(axis=1), std[:, 9:].max(axis=1))
-    table = Table(title=escape(f"Kg per temperature (B, resid and sd B in [{cal.input_units}])"),
-                  caption="sd K / sd mis / sd B: largest 1-sigma of Kxx..Kzz / of the 6 misalignments / of Bx..Bz",
-                  box=SIMPLE, padding=(0, 1), collapse_padding=True, show_edge=False)
-    for col in ("T degC", "Kxx", "Kyy", "Kzz", "Bx", "By", "Bz", "resid", "sd K", "sd mis", "sd B"):
-        table.add_column(escape(col), justify="right", no_wrap=True, min_width=7)
+    # two tables, so that each fits 80 columns (piped output, small terminals)
+    style = dict(box=SIMPLE, padding=(0, 1), collapse_padding=True, show_edge=False)
+    table = Table(title=escape(f"Kg per temperature (B and resid in [{cal.input_units}])"), **style)
+    sds = Table(title=escape(f"largest 1-sigma per temperature (sd B in [{cal.input_units}])"),
+                caption="sd K / sd mis / sd B: of Kxx..Kzz / of the 6 misalignments / of Bx..Bz", **style)
+    for t_, cols in ((table, ("T degC", "Kxx", "Kyy", "Kzz", "Bx", "By", "Bz", "resid")),
+                     (sds, ("T degC", "sd K", "sd mis", "sd B"))):
+        for col in cols:
+            t_.add_column(escape(col), justify="right", no_wrap=True, min_width=7)
     for i, t in enumerate(cal.temps):
         k = user[i]
         table.add_row(f"{t:.1f}", *(f"{k[j]:.5f}" for j in (0, 1, 2)),
                       *(f"{k[j]:.4f}" for j in (9, 10, 11)),
-                      f"{np.max(cal.residual_rms[i]) / unit_factor(cal.input_units):.2g}",
-                      *(f"{g[i]:.1e}" for g in groups))
+                      f"{np.max(cal.residual_rms[i]) / unit_factor(cal.input_units):.2g}")
+        sds.add_row(f"{t:.1f}", *(f"{g[i]:.1e}" for g in groups))
     console.print(table)
+    console.print(sds)
     console.print(f"{len(fit.steps)} steps; smooth model orders (Kg order): "
                   + " ".join(map(str, cal.smooth.orders.tolist())))
 
