@@ -195,12 +195,13 @@ def _print_calibration(run, truth: Calibration | None = None) -> None:
     if cal.noise_std is not None:
         noise = cal.noise_std / cal.input_scale
         console.print(f"per-sample noise behind the 1-sigma: {', '.join(f'{v:.3g}' for v in noise)} {cal.input_units}",
-                      highlight=False)
+                      highlight=False, soft_wrap=True)
     if (note := run.scale_bias_note()) is not None:
-        console.print("note: " + note.replace("method first-moment", "--method first-moment"), highlight=False)
+        console.print("note: " + note.replace("method first-moment", "--method first-moment"), highlight=False,
+                      soft_wrap=True)
     n_rot = sum(w.get("kind") == "rotation" for w in cal.windows)
     console.print(f"windows used: {n_rot} rotation, {len(cal.windows) - n_rot} static; found: "
-                  f"{describe_found(run.segmentation.windows, run.segmentation.ignored)}", highlight=False)
+                  f"{describe_found(run.segmentation.windows, run.segmentation.ignored)}", highlight=False, soft_wrap=True)
 
 
 def _truth_calibration(path: Path, cal: Calibration) -> Calibration | None:
@@ -280,7 +281,7 @@ def calibrate(
 
         write_json(output, doc)
     if example:
-        console.print(intro, highlight=False)
+        console.print(intro, highlight=False, soft_wrap=True)
     _print_calibration(run, None if truth_path is None else _truth_calibration(truth_path, cal))
     if output is not None:
         console.print(f"wrote {output}" + (f" and {plot}" if plot is not None else ""), highlight=False)
