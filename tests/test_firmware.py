@@ -457,3 +457,11 @@ def test_temperature_filter_matches_the_forward_low_pass_and_removes_the_steps(c
     assert np.max(np.abs(out - ref)) < 1e-4  # float32 state over 60,000 steps near 30 degC
     # a 1 degC step of the reading moves the filtered temperature by at most 2 alpha (lag < 1 degC) per sample
     assert np.max(np.abs(np.diff(out))) < 2 * (1 - a) < 0.01
+
+
+def test_c_and_python_share_the_range_margin():
+    from gyrocal.thermal.lagrange import RANGE_MARGIN
+
+    header = (firmware.c_source_dir() / "gyrocal_cal.h").read_text()
+    margin = re.search(r"#define GYROCAL_THERMAL_MARGIN ([0-9.]+)f", header)
+    assert margin is not None and float(margin.group(1)) == RANGE_MARGIN

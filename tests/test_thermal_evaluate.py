@@ -1,5 +1,7 @@
 """Evaluation like seed 001's Tables 3-4 and Figures 4-9, the report folder, and the figures."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -93,3 +95,21 @@ def test_figures_draw_the_expected_artists(calibrated):
     temp = plot_error_vs_temperature(ev, fig.add_subplot())
     assert set(temp["lines"]) == set(METHODS)
     assert len(temp["lines"]["lagrange"].get_xdata()) == 4
+
+
+def test_out_of_range_steps_are_refused_or_warned_about_once(calibrated):
+    import warnings
+
+    from gyrocal.errors import OutOfRangeError
+    from gyrocal.thermal import ThermalRangeWarning
+    from gyrocal.thermal.evaluate import evaluate_steps
+
+    _, cal, ev = calibrated
+    hot = dataclasses.replace(ev.steps, temp=ev.steps.temp + 20.0)  # the 45 degC steps land at 65
+    with pytest.raises(OutOfRangeError, match="outside the calibrated range"):
+        evaluate_steps(cal, hot)
+    for policy in ("clamp", "extrapolate"):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            evaluate_steps(cal, hot, policy)
+        assert [type(w.message) for w in caught] == [ThermalRangeWarning], policy

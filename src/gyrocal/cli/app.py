@@ -52,12 +52,12 @@ def warn(message: str) -> None:
 
 @contextlib.contextmanager
 def warnings_as_lines():
-    """Show the library's warnings raised inside the block as one ``warning:`` line each, once."""
+    """Show the library's warnings raised inside the block as one ``warning:`` line each."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         yield
-    for message in dict.fromkeys(str(w.message) for w in caught):  # the same warning from two models: once
-        warn(message)
+    for w in caught:
+        warn(str(w.message))
 
 
 def _is_usage_error(exc: BaseException) -> bool:

@@ -18,7 +18,7 @@ import numpy as np
 from ..recording import Recording
 from ..units import unit_factor
 from ._warn import ThermalRangeWarning
-from .lagrange import OutOfRange, interpolate
+from .lagrange import OutOfRange, interpolate, range_policy
 from .model import ThermalCalibration
 from .session import AXES, Steps, drop_saturated, drop_unstable, find_steps
 
@@ -91,9 +91,13 @@ class Evaluation:
 def evaluate_steps(cal: ThermalCalibration, steps: Steps, out_of_range: OutOfRange = "refuse") -> Evaluation:
     """Errors of every method on reduced steps."""
     ref = steps.reference
+    # the range policy once for all methods (one refusal or one warning), then every method on its result
+    temp = range_policy(cal.temps, steps.temp, out_of_range)
     errors = {"uncompensated": steps.mean - ref}
-    for m in METHODS[1:]:
-        errors[m] = cal.compensate(steps.mean, steps.temp, m, out_of_range) - ref
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ThermalRangeWarning)  # already said above
+        for m in METHODS[1:]:
+            errors[m] = cal.compensate(steps.mean, temp, m, "extrapolate") - ref
     return Evaluation(steps=steps, errors=errors)
 
 
