@@ -16,8 +16,8 @@ import typer
 
 from ..errors import InputError
 from ._outputs import check_output, json_format, starts_with
-from .app import app, console
-from .calibrate_cmds import Columns, SampleRate, Units, _read
+from .app import app, console, warnings_as_lines
+from .calibrate_cmds import Columns, OutputUnits, SampleRate, Sensitivity, Units, _read
 
 TRUTH_FORMAT = "gyrocal.simulation-truth"
 _SIMULATED = "gyrocal simulate"  # first words of a simulated recording: a later simulate may replace it
@@ -256,43 +256,81 @@ def simulate(
     console.print(f"wrote {output} ({len(rec)} samples, {len(rec) / sample_rate:.1f} s, {unit}) and {truth_path}")
 
 
+class MotionChoice(str, Enum):
+    restrict = "restrict"
+    refuse = "refuse"
+
+
+def _figure_cell(fig, r: int, factor: float, missing: str) -> str:
+    """Value over its interval, e.g. ``3.438`` over ``3.43-3.45``."""
+    v = fig.value[r] * factor
+    if not math.isfinite(v):
+        return missing
+    if not (math.isfinite(fig.low[r]) and math.isfinite(fig.high[r])):
+        return f"{v:.4g}"
+    return f"{v:.4g}\n{fig.low[r] * factor:.3g}-{fig.high[r] * factor:.3g}"
+
+
+def _noise_table(title: str, sensor, fs: float, factors: tuple[float, float, float], heads: tuple[str, str, str]):
+    from rich.table import Table
+
+    table = Table(title=title)
+    for col in ("axis", heads[0], "\u03c3/sample", heads[1], "at \u03c4\ns", heads[2]):
+        table.add_column(col, justify="right", no_wrap=True)
+    std = sensor.noise_std(fs)
+    for r, name in enumerate(("x", "y", "z", "sensor")):
+        table.add_row(name, _figure_cell(sensor.density, r, factors[0], "-"), f"{std[r]:.4g}",
+                      _figure_cell(sensor.bias_instability, r, factors[1], "not reached"),
+                      f"{sensor.bias_instability.tau[r]:.4g}" if math.isfinite(sensor.bias_instability.tau[r]) else "-",
+                      _figure_cell(sensor.random_walk, r, factors[2], "not seen"))
+    return table
+
+
 @app.command()
 def noise(
-    recording: Annotated[Path, typer.Argument(help="Static recording: CSV, Parquet or a ROS/MCAP bag.")],
+    recording: Annotated[Path, typer.Argument(help="Recording at rest: CSV, Parquet or a ROS/MCAP bag.")],
     units: Units = None,
     columns: Columns = None,
     sample_rate: SampleRate = None,
+    sensitivity: Sensitivity = None,
+    output_units: OutputUnits = None,
+    motion: Annotated[MotionChoice, typer.Option(
+        "--motion", help="A log that moves: analyse its longest still stretch (restrict) or refuse it.")]
+    = MotionChoice.restrict,
     plot: Annotated[Optional[Path], typer.Option("--plot", help="Allan deviation plot (.png, .pdf, .svg).")] = None,
     json_out: Annotated[Optional[Path], typer.Option("--json", help="Write the noise figures as JSON.")] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace a --json file that is not a noise file.")]
     = False,
 ) -> None:
-    """Allan deviation of a static recording: angle random walk, bias instability, rate random walk."""
-    from rich.table import Table
+    """Allan deviation of a log at rest: noise density, bias instability, random walk, with intervals."""
+    from ..noise import FORMAT, characterise_recording, save_noise
+    from ..units import parse_rate_unit, unit_factor
 
-    from ..noise import FORMAT, characterise, save_noise
-
+    # every output is checked before anything is computed or written
     check_output(json_out, flag="--json", inputs=(recording,), force=force, replaceable=json_format(FORMAT))
     check_output(plot, flag="--plot", inputs=(recording, json_out), force=True)
+    if plot is not None:
+        from ..plotting._mpl import check_figure_path
 
+        check_figure_path(plot)
+        if json_out is not None and plot.absolute() == json_out.absolute():
+            raise InputError(f"--plot and --json are both {plot}; give two different files")
     if units is None:
-        raise InputError("--units is required (rad/s or deg/s): the Allan deviation is reported in physical units")
-    rec = _read(recording, units, columns, sample_rate, None, None, None)
-    report = characterise(rec.gyro, rec.sample_rate)
-    table = Table(title=f"{recording.name}: {report.duration:.0f} s at {report.sample_rate:g} Hz")
-    # Short names over their units, so the table fits 80 columns without cutting a header.
-    for col in ("axis", "ARW\ndeg/\u221ah", "density\nrad/s/\u221aHz", "\u03c3/sample\nrad/s", "bias inst.\ndeg/h",
-                "at \u03c4\ns", "RRW\ndeg/h/\u221ah"):
-        table.add_column(col, justify="right", no_wrap=True)
-    def shown(value: float, factor: float, missing: str) -> str:
-        return f"{value * factor:.4g}" if math.isfinite(value) else missing
-
-    deg_h = math.degrees(1.0) * 3600
-    for a in range(3):
-        table.add_row("xyz"[a], shown(report.arw[a], math.degrees(1.0) * 60, "-"), f"{report.arw[a]:.4g}",
-                      f"{report.noise_std[a]:.4g}", shown(report.bias_instability[a], deg_h, "not reached"),
-                      shown(report.bias_instability_tau[a], 1.0, "-"), shown(report.rrw[a], deg_h * 60, "not seen"))
-    console.print(table)
+        raise InputError("--units is required (rad/s, deg/s, or counts with --sensitivity): the noise figures are "
+                         "physical quantities")
+    if units == "counts" and sensitivity is None:
+        raise InputError("--units counts needs --sensitivity (LSB per --output-units, e.g. 131 for a +-250 deg/s "
+                         "MPU-9250): noise figures are physical quantities")
+    rec = _read(recording, units, columns, sample_rate, sensitivity, output_units, None)
+    with warnings_as_lines():
+        report = characterise_recording(rec, motion=motion.value, source={"file": recording.name})
+    shown = parse_rate_unit(rec.source_units if rec.source_units != "counts" else (output_units or "deg/s"))
+    per = 1.0 / unit_factor(shown)
+    fs = report.sample_rate
+    console.print(_noise_table(
+        f"{recording.name}: gyro, {report.duration:.0f} s at {fs:g} Hz, {100 * report.confidence:.0f} % intervals",
+        report.gyro, fs, (per, per, per), (f"density\n{shown}/\u221aHz", f"bias inst.\n{shown}",
+                                           f"random walk\n{shown}/s/\u221aHz")))
     if json_out is not None:
         save_noise(json_out, report)
         console.print(f"wrote {json_out}")
