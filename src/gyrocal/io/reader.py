@@ -21,6 +21,10 @@ def _kind(path: Path) -> str:
             return "bag"
         raise InputError(f"{path}: a folder, but not a ROS 2 bag (no metadata.yaml, .db3 or .mcap inside)")
     suffix = path.suffix.lower()
+    from .flightlog import flight_log_kind
+
+    if flight_log_kind(path) is not None:
+        return "flight"
     if suffix in (".parquet", ".pq"):
         return "parquet"
     if suffix in BAG_SUFFIXES:
@@ -46,6 +50,7 @@ def read_recording(
     check_units: bool = True,
     saturation: SaturationPolicy = "error",
     full_scale: float | None = None,
+    imu: int | None = None,
 ) -> Recording:
     """Read a gyro recording from a file and check it.
 
@@ -53,8 +58,9 @@ def read_recording(
     ----------
     path : path-like
         A delimited text table (``.csv .txt .tsv .dat``), a ``.parquet`` file, a ROS 1
-        ``.bag``, a ROS 2 bag folder or its ``.db3`` / ``.mcap`` file. The format is
-        chosen by suffix, then by the file's first bytes.
+        ``.bag``, a ROS 2 bag folder or its ``.db3`` / ``.mcap`` file, a PX4 ULog (``.ulg``)
+        or an ArduPilot DataFlash log (``.bin``). The format is chosen by suffix, then by
+        the file's first bytes.
     units : {"rad/s", "deg/s", "counts"}
         Unit of the rate columns as written in the file.
     columns : dict or str, optional
@@ -81,6 +87,9 @@ def read_recording(
     full_scale : float, optional
         Sensor limit in the file's units; without it, saturation is recognised by runs
         of identical readings at the largest magnitude.
+    imu : int, optional
+        For a PX4 ULog or ArduPilot DataFlash log (:func:`gyrocal.io.read_flight_log`): which
+        IMU instance, needed when the log holds several.
 
     Returns
     -------
@@ -96,6 +105,14 @@ def read_recording(
     if not path.exists():
         raise InputError(f"recording {str(path)!r} does not exist")
     kind = _kind(path)
+    if kind == "flight":
+        from .flightlog import read_flight_log
+
+        if columns:
+            raise InputError("columns= does not apply to PX4 and ArduPilot logs (their IMU fields are used)")
+        return read_flight_log(path, imu=imu, units=units, check_units=check_units, saturation=saturation)[0]
+    if imu is not None:
+        raise InputError("imu= applies only to PX4 ULog and ArduPilot DataFlash logs")
     if kind == "bag":
         from .rosbag import read_bag_columns
 
