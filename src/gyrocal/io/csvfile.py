@@ -73,7 +73,8 @@ def _is_number(cell: str) -> bool:
     return True
 
 
-def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool | None = None):
+def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool | None = None,
+                     accel: bool = False):
     """Read a text table.
 
     Parameters
@@ -83,6 +84,8 @@ def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool
         Canonical name -> file column (see :func:`gyrocal.io._columns.resolve`).
     use_pyarrow : bool, optional
         Force (True) or forbid (False) the pyarrow reader; default: when installed.
+    accel : bool
+        Look for the accelerometer columns ``ax, ay, az`` too.
 
     Returns
     -------
@@ -101,7 +104,7 @@ def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool
             f"{path.name}: the first line ({lines[h][:40].strip()!r}) is data, not a header; add a header row "
             f"naming the columns, e.g. {sep.join(('t', 'gx', 'gy', 'gz'))!r} (t optional with --sample-rate)"
         )
-    mapping = resolve(names, columns, path.name)
+    mapping = resolve(names, columns, path.name, accel=accel)
     if use_pyarrow is None:
         try:
             import pyarrow.csv  # noqa: F401
