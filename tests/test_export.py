@@ -88,3 +88,14 @@ def test_failed_export_leaves_no_output(tmp_path):
     with pytest.raises(FileFormatError, match="not valid JSON"):
         export_file(bad, "yaml", out)
     assert not out.exists()
+
+
+def test_export_command_takes_a_prefix_for_c_headers_only(cal_path, tmp_path):
+    from cli_runner import invoke, refused
+
+    code, _, err = invoke("export", cal_path, "--format", "c-header", "--prefix", "imu2", "-o", tmp_path / "a.h")
+    assert code == 0, err
+    assert "static const gyrocal_affine_t IMU2_CALIBRATION" in (tmp_path / "a.h").read_text()
+    line = refused("export", cal_path, "--format", "yaml", "--prefix", "imu2", "-o", tmp_path / "a.yaml")
+    assert "--prefix does not apply to yaml export" in line
+    assert not (tmp_path / "a.yaml").exists()

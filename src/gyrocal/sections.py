@@ -75,16 +75,16 @@ def integer(lo: int = 0) -> Check:
     return check
 
 
-def boolean(v):
-    if not isinstance(v, bool):
-        raise ValueError(f"must be true or false, got {v!r}")
-    return v
+def instance(types, what: str) -> Check:
+    """A value of one of `types` (described as `what` in messages)."""
+    def check(v):
+        if not isinstance(v, types):
+            raise ValueError(f"must be {what}, got {_thaw(v)!r}")
+        return v
+    return check
 
 
-def text(v):
-    if not isinstance(v, str):
-        raise ValueError(f"must be text, got {v!r}")
-    return v
+boolean, text, obj = instance(bool, "true or false"), instance(str, "text"), instance(Mapping, "an object")
 
 
 def texts(v):
@@ -104,12 +104,6 @@ def numbers(shape: tuple[int, ...], lo: float = -math.inf) -> Check:
             raise ValueError(f"must be numbers of shape {shape} (each >= {lo:g}), got shape {arr.shape}")
         return v
     return check
-
-
-def obj(v):
-    if not isinstance(v, Mapping):
-        raise ValueError(f"must be an object, got {_thaw(v)!r}")
-    return v
 
 
 class Section(Mapping):
