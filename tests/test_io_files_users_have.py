@@ -264,3 +264,14 @@ def test_epoch_time_stamps_give_the_same_calibration(tmp_path):
         base_windows, base_params = runs[0.0, ref]
         assert windows == base_windows, (start, ref)
         np.testing.assert_allclose(params, base_params, rtol=1e-6, atol=1e-9)
+
+
+@pytest.mark.parametrize("use_pyarrow", [True, False])
+def test_units_row_under_the_header_is_skipped_and_a_bad_first_row_is_not(tmp_path, rng, use_pyarrow):
+    t, g = _table(rng)
+    (tmp_path / "daq.csv").write_text("Time,gyro_x,gyro_y,gyro_z\n[s],[deg/s],[deg/s],[deg/s]\n" + _text(t, g, header=""))
+    _same(read_csv_columns(tmp_path / "daq.csv", use_pyarrow=use_pyarrow)[0], t, g)
+    # a first data row of text is not taken for units: it stays data and is reported
+    (tmp_path / "bad.csv").write_text("t,gx,gy,gz\n0,oops,x,y\n" + _text(t[1:], g[1:], header=""))
+    with pytest.raises(InputError, match=r"column 'gx' holds non-numeric cell 'oops' at data row 1"):
+        read_csv_columns(tmp_path / "bad.csv", use_pyarrow=use_pyarrow)

@@ -45,6 +45,9 @@ class Layout:
         Numbers are written ``1,5`` (never with a comma delimiter).
     names : list of str
         Column names: the header's, or ``"1" .. "n"`` for a table without a header.
+    others : tuple of Layout
+        Other readings to try, in order, when the names do not hold the gyro columns: a header
+        over a units row, where this reading took the units for names.
     """
 
     header: int | None
@@ -52,6 +55,7 @@ class Layout:
     delimiter: str | None
     decimal_comma: bool
     names: list[str]
+    others: tuple["Layout", ...] = ()
 
 
 def split(line: str, delimiter: str | None) -> list[str]:
@@ -157,22 +161,45 @@ def find_layout(lines: list[str], source: str = "file", skip_rows: int | None = 
     comma = _decimal_comma([lines[i] for i in content[-_TAIL:] if _is_data(lines[i], fit)], fit)
     if skip_rows is not None:
         return _layout_at(lines, content, 0, fit, comma)
-    for pos, i in enumerate(content[:-1]):
-        cells = split(lines[i], fit.delimiter)
-        if len(cells) in (fit.width, fit.width - 1) and (not _is_data(lines[i], fit) or _is_numbered_header(cells)) \
-                and _is_data(lines[content[pos + 1]], fit):
+    return _detect(lines, content, fit, comma)
+
+
+def _detect(lines: list[str], content: list[int], fit: _Fit, comma: bool) -> Layout:
+    """The header: the first line of names followed by a data row. Names right above it are
+    kept as other readings (a header over a units row, or metadata of the table's width)."""
+
+    def is_row(pos: int) -> bool:
+        line = lines[content[pos]]  # pandas writes its numbered header first, and only there
+        return _is_data(line, fit) and not (pos == 0 and _is_numbered_header(split(line, fit.delimiter)))
+
+    def is_names(pos: int) -> bool:
+        return len(split(lines[content[pos]], fit.delimiter)) in (fit.width, fit.width - 1) and not is_row(pos)
+
+    rows = [is_row(pos) for pos in range(len(content))]
+    first = next((pos for pos in range(len(content) - 1) if not rows[pos] and is_names(pos) and rows[pos + 1]), None)
+    if first is None:
+        data = next((pos for pos, row in enumerate(rows) if row), None)
+        if data is None:  # no data row at all: the first line of the table's width is its header
+            pos = next((p for p, i in enumerate(content) if len(split(lines[i], fit.delimiter)) == fit.width), 0)
             return _layout_at(lines, content, pos, fit, comma)
-    first = next((pos for pos, i in enumerate(content) if _is_data(lines[i], fit)), None)
-    if first is None:  # no data row at all: the first line of the table's width is its header
-        pos = next((p for p, i in enumerate(content) if len(split(lines[i], fit.delimiter)) == fit.width), 0)
-        return _layout_at(lines, content, pos, fit, comma)
-    commented = _comment_header(lines, content[first], fit)
-    if commented is not None:
-        return Layout(commented[0], content[first], fit.delimiter, comma, commented[1])
-    return Layout(None, content[first], fit.delimiter, comma, [str(j + 1) for j in range(fit.width)])
+        commented = _comment_header(lines, content[data], fit)
+        if commented is not None:
+            return Layout(commented[0], content[data], fit.delimiter, comma, commented[1])
+        return Layout(None, content[data], fit.delimiter, comma, [str(j + 1) for j in range(fit.width)])
+    block = [first]
+    while block[0] > 0 and is_names(block[0] - 1):
+        block.insert(0, block[0] - 1)
+    layouts = []
+    for j in reversed(range(len(block))):
+        between = [lines[content[p]] for p in block[j + 1:]]
+        data = first + 1 if all(_is_units_row(line, fit) for line in between) else block[j] + 1
+        layouts.append(_layout_at(lines, content, block[j], fit, comma, data=content[data]))
+    # a header over a units row ("s,deg/s,...") is the second reading, metadata of the table's width the first
+    return Layout(**{**layouts[0].__dict__, "others": tuple(layouts[1:])})
 
 
-def _layout_at(lines: list[str], content: list[int], pos: int, fit: _Fit, comma: bool) -> Layout:
+def _layout_at(lines: list[str], content: list[int], pos: int, fit: _Fit, comma: bool, *, data: int | None = None) \
+        -> Layout:
     """The header at ``content[pos]`` (or, when that line is data, a table without a header)."""
     i = content[pos]
     cells = split(lines[i], fit.delimiter)
@@ -180,8 +207,19 @@ def _layout_at(lines: list[str], content: list[int], pos: int, fit: _Fit, comma:
         return Layout(None, i, fit.delimiter, comma, [str(j + 1) for j in range(len(cells))])
     if len(cells) == fit.width - 1:  # R's write.csv: no name above the row-name column
         cells = ["", *cells]
-    data = content[pos + 1] if pos + 1 < len(content) else len(lines)
+    if data is None:
+        data = content[pos + 1] if pos + 1 < len(content) else len(lines)
     return Layout(i, data, fit.delimiter, comma, cells)
+
+
+_UNITS = {"", "s", "sec", "secs", "seconds", "ms", "us", "µs", "ns", "min", "h", "deg", "degree", "degrees", "rad",
+          "dps", "deg/s", "°/s", "º/s", "rad/s", "rps", "rpm", "mdps", "degc", "°c", "ºc", "c", "k", "lsb", "count",
+          "counts", "raw", "g", "mg", "m/s2", "m/s^2", "m/s²", "hz", "%", "-", "1", "ut", "µt", "gauss"}
+
+
+def _is_units_row(line: str, fit: _Fit) -> bool:
+    """A row of units under a header: ``s,deg/s,deg/s,deg/s`` or ``[s];[dps];...``."""
+    return all(re.sub(r"[\s\[\]\(\)\{\}]", "", c).lower() in _UNITS for c in split(line, fit.delimiter))
 
 
 def _comment_header(lines: list[str], first_data: int, fit: _Fit) -> tuple[int, list[str]] | None:

@@ -79,6 +79,25 @@ def _headerless(path: Path, lines: list[str], layout: Layout) -> InputError:
     )
 
 
+def _mapped(path: Path, lines: list[str], layout: Layout, columns) -> tuple[Layout, dict[str, str]]:
+    """The layout whose names hold the gyro columns (the first reading, else another one, e.g. the
+    header over a units row) and the mapping of canonical names to its columns."""
+    names = layout.names
+    if not columns and layout.header is not None and names == [str(i) for i in range(len(names))]:
+        raise InputError(
+            f"{path.name}: the header ({lines[layout.header][:40].strip()!r}) numbers the columns from 0, as pandas "
+            f"writes them; say which column holds what by those names, e.g. --columns t=0,gx=1,gy=2,gz=3"
+        )
+    error = None
+    for reading in (layout, *layout.others):
+        where = "no header row; columns count from 1" if reading.header is None else f"header on line {reading.header + 1}"
+        try:
+            return reading, resolve(reading.names, columns, path.name, where=where, header=reading.header is not None)
+        except InputError as exc:
+            error = error or exc
+    raise error
+
+
 def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool | None = None,
                      skip_rows: int | None = None):
     """Read a text table, plain or compressed.
@@ -108,14 +127,8 @@ def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool
     layout = find_layout(lines, path.name, skip_rows)
     if layout.header is None and not columns:
         raise _headerless(path, lines, layout)
+    layout, mapping = _mapped(path, lines, layout, columns)
     names = layout.names
-    if not columns and layout.header is not None and names == [str(i) for i in range(len(names))]:
-        raise InputError(
-            f"{path.name}: the header ({lines[layout.header][:40].strip()!r}) numbers the columns from 0, as pandas "
-            f"writes them; say which column holds what by those names, e.g. --columns t=0,gx=1,gy=2,gz=3"
-        )
-    where = "no header row; columns count from 1" if layout.header is None else f"header on line {layout.header + 1}"
-    mapping = resolve(names, columns, path.name, where=where, header=layout.header is not None)
     if use_pyarrow is None:
         try:
             import pyarrow.csv  # noqa: F401
