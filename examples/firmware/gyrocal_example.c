@@ -52,7 +52,7 @@ static void report(example_t *ex, unsigned events)
     if (events & GYROCAL_SESSION_RESULT) {
         board_write(ex->frame, gyrocal_frame_result(ex->frame, s->status, GYROCAL_METHOD_FIRST_MOMENT,
                                                     (uint8_t)s->iterations, GYROCAL_N_OBS,
-                                                    s->status == GYROCAL_OK ? &s->result : 0, s->seq));
+                                                    s->status == GYROCAL_OK ? &s->result : 0, s->seq - 1u));
         if (s->status == GYROCAL_OK) {
             gyrocal_scale_bias_to_affine(&s->result, &ex->cal);
             ex->calibrated = 1;

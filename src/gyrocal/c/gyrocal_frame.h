@@ -93,7 +93,7 @@ size_t gyrocal_frame_sample(uint8_t out[GYROCAL_FRAME_MAX], uint32_t seq, uint32
 size_t gyrocal_frame_calibrated(uint8_t out[GYROCAL_FRAME_MAX], uint32_t seq, uint32_t t_us, const float w[3]);
 size_t gyrocal_frame_turn(uint8_t out[GYROCAL_FRAME_MAX], const gyrocal_turn_t *turn);
 /* The device's calibration: status, method, iterations, turns used, k [rate unit per count], b [counts],
- * and the sample count when it was computed. */
+ * and the sample that completed it (the first one the result corrects). */
 size_t gyrocal_frame_result(uint8_t out[GYROCAL_FRAME_MAX], gyrocal_status_t status, uint8_t method,
                             uint8_t iterations, uint8_t n_turns, const gyrocal_scale_bias_t *sb, uint32_t seq);
 /* A NUL-terminated message, cut at GYROCAL_FRAME_MAX_PAYLOAD bytes. */

@@ -129,7 +129,7 @@ class CDevice:
         if events & 2:
             ok = s.status == 0
             out += self._out(self.dll.gyrocal_frame_result(self._buf, s.status, 0, s.iterations, 6,
-                                                           ctypes.byref(s.result) if ok else None, s.seq))
+                                                           ctypes.byref(s.result) if ok else None, s.seq - 1))
         return out
 
     def firmware_stream(self, raw, t_us, temp=None, *, sample_rate: float, sensitivity: float,
