@@ -165,10 +165,9 @@ class TextDecoder:
         self._buf = bytearray(rest)
         return out
 
-    def finish(self) -> list[Reading]:
-        """A last line without its newline (the stream ended)."""
-        out: list[Reading] = []
+    def finish(self) -> None:
+        """The stream ended: a last line without its newline may be cut short, so it is counted, not used."""
         if self._buf.strip():
-            self._line(bytes(self._buf), out)
+            self.stats.lines += 1
+            self.stats.bad_lines += 1
         self._buf = bytearray()
-        return out
