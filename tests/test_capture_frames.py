@@ -128,7 +128,7 @@ def test_corrupt_bytes_are_caught_by_the_crc(rng):
 
 
 def test_garbage_between_frames_is_skipped_and_counted(rng):
-    data, raw = samples_stream(10)
+    data, _raw = samples_stream(10)
     size = len(data) // 10
     noise = bytes(rng.integers(0, 256, 37, dtype=np.uint8).tolist()).replace(fr.SYNC, b"")
     stream = data[: 5 * size] + noise + data[5 * size:]

@@ -33,9 +33,9 @@ def session():
     return simulate_device_session(proto, model=model, noise_std=0.01, rng=rng)
 
 
-def capture(tmp_path, data: bytes, faults=Faults(), transport="pty", **kwargs):
+def capture(tmp_path, data: bytes, faults=None, transport="pty", **kwargs):
     events = []
-    with VirtualDevice(data, faults=faults, transport=transport) as dev:
+    with VirtualDevice(data, faults=faults or Faults(), transport=transport) as dev:
         port = dev.start()
         def on_event(kind, payload):
             events.append((kind, payload))

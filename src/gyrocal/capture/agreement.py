@@ -27,7 +27,7 @@ from ..estimators import FirstMoment
 from ..observations import ObservationSet
 from .frames import TURN_LABELS, Result, Turn
 
-__all__ = ["C_ROUND", "EPS32", "Agreement", "accumulator_bound", "solution_bound", "check_device"]
+__all__ = ["C_ROUND", "EPS32", "Agreement", "accumulator_bound", "check_device", "solution_bound"]
 
 EPS32 = float(np.finfo(np.float32).eps)
 C_ROUND = 32.0

@@ -20,7 +20,7 @@ import threading
 import time
 import tty
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Literal, Self
 
 import numpy as np
 
@@ -143,6 +143,8 @@ class VirtualDevice:
         self.data, self.faults, self.byte_rate, self.transport = data, faults, byte_rate, transport
         self.wait_for, self.settle = wait_for, settle
         self._go = threading.Event()
+        self.paused = threading.Event()  # set once the reader has taken everything sent before the stall
+        self._resume = threading.Event()
         self.chunk, self.drain_timeout = chunk, drain_timeout
         self.sent = 0
         self.done = threading.Event()
@@ -170,6 +172,10 @@ class VirtualDevice:
         """Start sending (the reader has opened the port)."""
         self._go.set()
 
+    def resume(self) -> None:
+        """End the stall now."""
+        self._resume.set()
+
     def _wait_to_start(self) -> None:
         if self.wait_for == "reader" and self.transport == "pty":
             mine = termios.tcgetattr(self._slave)
@@ -186,10 +192,11 @@ class VirtualDevice:
 
     def close(self) -> None:
         self._stop.set()
+        self._resume.set()
         if self._thread is not None:
             self._thread.join(5.0)
 
-    def __enter__(self) -> VirtualDevice:
+    def __enter__(self) -> Self:
         return self
 
     def __exit__(self, *exc) -> None:
@@ -211,7 +218,10 @@ class VirtualDevice:
         pos = 0
         while pos < cut and not self._stop.is_set():
             if stall is not None and pos == stall:
-                self._stop.wait(self.faults.stall_s)
+                if self.transport == "pty":
+                    self._drain()
+                self.paused.set()
+                self._resume.wait(self.faults.stall_s)
                 t0 += self.faults.stall_s  # pace on from here, no burst to catch up
                 stall = None
                 continue

@@ -20,8 +20,21 @@ from dataclasses import dataclass, field
 import numpy as np
 
 __all__ = [
-    "SYNC", "MAX_PAYLOAD", "OVERHEAD", "TURN_LABELS", "Hello", "Sample", "Calibrated", "Turn", "Result", "Text",
-    "Frame", "FrameDecoder", "DecoderStats", "crc16", "encode_samples",
+    "MAX_PAYLOAD",
+    "OVERHEAD",
+    "SYNC",
+    "TURN_LABELS",
+    "Calibrated",
+    "DecoderStats",
+    "Frame",
+    "FrameDecoder",
+    "Hello",
+    "Result",
+    "Sample",
+    "Text",
+    "Turn",
+    "crc16",
+    "encode_samples",
 ]
 
 SYNC = b"\xa5\x5a"
@@ -87,7 +100,7 @@ class Sample:
     temp: float | None = None
 
     def payload(self) -> bytes:
-        temp = TEMP_NONE if self.temp is None else int(round(self.temp * 100))
+        temp = TEMP_NONE if self.temp is None else round(self.temp * 100)
         return self.FORMAT.pack(self.seq & 0xFFFFFFFF, self.t_us & 0xFFFFFFFF, *self.raw, temp)
 
     @classmethod

@@ -107,6 +107,11 @@ class Capture:
         self.result = CaptureResult(out, SampleStore(out, header_comment or self._comment), "", None, None)
         self._t_wall0: float | None = None
 
+    def link_stats(self):
+        """The decoder's counts so far (frames: CRC errors, lost samples; text: bad lines)."""
+        dec = self._frames or self._text
+        return None if dec is None else dec.stats
+
     def _comment(self) -> str:
         h = self.result.hello
         dev = "" if h is None else (f"; device {h.firmware or '?'}, {h.sample_rate:g} Hz, sensitivity "
@@ -176,7 +181,7 @@ class Capture:
     # -- the loop --------------------------------------------------------------------------------------------
 
     def run(self, stop: Callable[[], bool] = lambda: False,
-            each: Callable[["Capture"], bool] | None = None) -> CaptureResult:
+            each: Callable[[Capture], bool] | None = None) -> CaptureResult:
         """Read until an end condition; `each` runs after every read and may end the capture (True).
 
         Whatever ends it, the file holds every sample decoded and is put in place before returning.
@@ -224,7 +229,7 @@ class Capture:
             if self._text is not None:
                 self._text.finish()
             r.ended = r.ended or "stopped"
-            r.stats = (self._frames or self._text).stats if (self._frames or self._text) else None
+            r.stats = self.link_stats()
             r.path = r.store.finish()
         if stalled:
             r.stalls.append(time.monotonic() - last_data)

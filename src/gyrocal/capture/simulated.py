@@ -18,7 +18,7 @@ from ..models import ScaleBias
 from ..simulation import ServoProtocol, VirtualGyro, simulate_servo
 from ..windows import Window
 
-__all__ = ["DeviceSession", "simulate_device_session", "MPU6050_SENSITIVITY"]
+__all__ = ["MPU6050_SENSITIVITY", "DeviceSession", "simulate_device_session"]
 
 #: LSB per deg/s of an MPU-6050 / MPU-9250 at +-250 deg/s.
 MPU6050_SENSITIVITY = 131.0

@@ -9,6 +9,7 @@ skipped and counted, never fatal; lines starting with ``#`` are messages from th
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from ..errors import InputError
@@ -139,7 +140,7 @@ class TextDecoder:
         if self._numbers is None:
             st.before_header += 1
             return
-        if len(values) < self._width or any(v != v or v in (float("inf"), float("-inf")) for v in values):
+        if len(values) < self._width or not all(math.isfinite(v) for v in values):
             st.bad_lines += 1
             return
         c = self._numbers
