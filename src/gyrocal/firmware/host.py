@@ -92,7 +92,7 @@ def build_library(
     if cc is None:
         raise MissingDependencyError("no C compiler found; install one (apt-get install gcc) or set CC")
     src = c_source_dir()
-    sources = [src / "gyrocal_cal.c", *map(Path, extra_sources)]
+    sources = [*sorted(src.glob("*.c")), *map(Path, extra_sources)]
     incs = [src, *map(Path, include_dirs)]
     digest = hashlib.sha256("\0".join([cc, *C_FLAGS]).encode())
     for path in sources + sorted(p for d in incs for p in Path(d).glob("*.h")):

@@ -71,13 +71,23 @@ def _found(names: Sequence[str]) -> str:
     return shown + (f", ... ({len(names)} in all)" if len(names) > 40 else "")
 
 
-def resolve(names: Sequence[str], columns: Mapping[str, str] | None, source: str, *,
-            accel: bool = False) -> dict[str, str]:
+def _by_number(wanted: str, names: Sequence[str]) -> str | None:
+    """The column at position `wanted` counting from 1, when `wanted` is such a number."""
+    text = wanted.strip()
+    if text.isdigit() and 1 <= int(text) <= len(names):
+        return names[int(text) - 1]
+    return None
+
+
+def resolve(names: Sequence[str], columns: Mapping[str, str] | None, source: str, *, where: str = "",
+            header: bool = True, accel: bool = False) -> dict[str, str]:
     """Map canonical names to the file's column names.
 
-    Explicit `columns` win; then an exact canonical name (any case); then an alias, only
-    when a single file column matches it. The accelerometer columns ``ax, ay, az`` are
-    looked for only with `accel` (otherwise they stay other columns, unless mapped).
+    Explicit `columns` win, by name (exact, then in any case) or by position counting from 1
+    (``gx=2``; a column named ``2`` wins over the second column); then an exact canonical name
+    (any case); then an alias, only when a single file column matches it. A table without a
+    `header` (names ``"1" .. "n"``) is mapped by `columns` alone. The accelerometer columns
+    ``ax, ay, az`` are looked for only with `accel` (otherwise they stay other columns, unless mapped).
 
     Raises
     ------
@@ -89,14 +99,20 @@ def resolve(names: Sequence[str], columns: Mapping[str, str] | None, source: str
     by_lower = {}
     for n in names:
         by_lower.setdefault(n.strip().lower(), n)
+    found = f"columns found{' (' + where + ')' if where else ''}: {_found(names)}"
     mapping: dict[str, str] = {}
     for canon, wanted in parse_columns(columns).items():
-        hit = wanted if wanted in names else by_lower.get(wanted.strip().lower())
+        hit = wanted if wanted in names else by_lower.get(wanted.strip().lower()) or _by_number(wanted, names)
         if hit is None:
-            raise InputError(f"{source}: column {wanted!r} (given for {canon}) is not in the file; columns found: {_found(names)}")
+            raise InputError(f"{source}: column {wanted!r} (given for {canon}) is not in the file; {found}; "
+                             f"give a name or a number from 1 to {len(names)}")
+        if hit in mapping.values():
+            other = next(c for c, n in mapping.items() if n == hit)
+            raise InputError(f"{source}: column {hit!r} is given for both {other} and {canon}; each quantity needs "
+                             "its own column")
         mapping[canon] = hit
     taken = set(mapping.values())
-    for canon in CANONICAL:
+    for canon in CANONICAL if header else ():
         if canon in mapping or (canon in ACCEL and not accel):
             continue
         if canon in by_lower and by_lower[canon] not in taken:
@@ -116,13 +132,13 @@ def resolve(names: Sequence[str], columns: Mapping[str, str] | None, source: str
     accel_missing = [c for c in ACCEL if c not in mapping]
     if (accel or len(accel_missing) < 3) and accel_missing and not missing:
         raise InputError(
-            f"{source}: no accelerometer column for {', '.join(accel_missing)}; columns found: {_found(names)}",
+            f"{source}: no accelerometer column for {', '.join(accel_missing)}; {found}",
             param="columns", hint="map them with {param} ax=NAME,ay=NAME,az=NAME")
     if missing:
-        raise InputError(
-            f"{source}: no column for {', '.join(missing)}; columns found: {_found(names)}; "
-            "map them with --columns gx=NAME,gy=NAME,gz=NAME"
-        )
+        how = ("by number, e.g. --columns gx=2,gy=3,gz=4" if not header else
+               "map them with --columns gx=NAME,gy=NAME,gz=NAME (or by number, gx=2), or, if the header is further "
+               "down, skip the lines above it (skip_rows=N)")
+        raise InputError(f"{source}: no column for {', '.join(missing)}; {found}; {how}")
     for canon, name in mapping.items():
         if names.count(name) > 1:  # readers would silently keep one of the copies
             raise InputError(
