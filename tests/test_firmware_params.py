@@ -50,7 +50,7 @@ def test_px4_needs_a_device_id_and_a_slot():
     tb = _bias()
     bare = ThermalBias(tb.coefs, tb.covariance, tb.orders, tb.tref, tb.tmin, tb.tmax, tb.cv_rms, tb.residual_rms,
                        tb.noise_std, tb.sample_rate, tb.duration)
-    with pytest.raises(InputError, match="device id.*--device-id"):
+    with pytest.raises(InputError, match="device id.*give the id .the CAL_GYROn_ID value. with device_id"):
         px4_params(bare)
     assert parse_px4(px4_params(bare, device_id=7))["TC_G0_ID"] == 7
     with pytest.raises(InputError, match="TC_G0..TC_G3"):

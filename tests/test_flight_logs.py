@@ -24,7 +24,7 @@ ULOG = Path(__file__).parent / "data" / "px4_ulog" / "sample_log_small.ulg"
 def test_real_ulog_holds_three_gyros_by_device_id():
     from pyulog import ULog
 
-    with pytest.raises(InputError, match=r"3 IMUs in this log \(0 \(device id 2424842\), 1 .*--imu N"):
+    with pytest.raises(InputError, match=r"3 IMUs in this log \(0 \(device id 2424842\), 1 .*choose one with imu N"):
         read_flight_log(ULOG)
     log = ULog(str(ULOG))
     for inst in range(3):
@@ -77,7 +77,7 @@ def test_dataflash_reader_undoes_orientation_temperature_correction_and_offsets(
     with pytest.raises(InputError, match="2 IMUs in this log"):
         read_flight_log(path)
     rec, info = read_flight_log(path, imu=0)
-    assert info["format"] == "dataflash" and info["imu"] == 1
+    assert info["format"] == "dataflash" and info["instance"] == 0 and info["imu_number"] == 1
     assert info["undone"] == ["AHRS_ORIENTATION 2", "INS_TCAL1 temperature correction", "INS_GYROFFS"]
     np.testing.assert_allclose(rec.t, 2e-3 + 0.04 * np.arange(n))
     # logged as float32: the raw readings come back within float32 rounding of the sizes involved

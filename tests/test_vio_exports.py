@@ -75,9 +75,9 @@ def test_imu_utils_layout(report):
 
 def test_missing_accelerometer_and_unseen_random_walk_are_never_invented(rng):
     short = characterise(rng.standard_normal((20_000, 3)) * 0.005, FS)
-    with pytest.raises(InputError, match="no accelerometer figures.*--accel-noise-density"):
+    with pytest.raises(InputError, match="no accelerometer figures.*accel_noise_density"):
         kalibr_yaml(short)
-    with pytest.raises(InputError, match="gyroscope random walk is not seen.*--random-walk-bound"):
+    with pytest.raises(InputError, match="gyroscope random walk is not seen.*use_bound"):
         kalibr_yaml(short, accel_noise_density=2e-3, accel_random_walk=4e-4)
     doc = yaml.safe_load(kalibr_yaml(short, accel_noise_density=2e-3, accel_random_walk=4e-4, use_bound=True))
     assert doc["gyroscope_random_walk"] == pytest.approx(short.gyro.random_walk_bound[3])

@@ -25,15 +25,16 @@ import os
 
 import numpy as np
 
-from .. import __version__
-from .._jsonfile import check_header, get, get_array, read_json, write_json
+from .._version import __version__
+from .._jsonfile import check_header, get, get_array
 from ..errors import FileFormatError, InputError
+from ..files import load, register, save
 from .thermal_bias import MAX_ORDER, ThermalBias
 
 __all__ = ["FORMAT", "VERSION", "from_document", "load_thermal_bias", "save_thermal_bias", "to_document"]
 
-FORMAT = "gyrocal.thermal-bias"
-VERSION = 1
+FORMAT = ThermalBias.FORMAT
+VERSION = ThermalBias.VERSION
 MODEL = "bias(T) = sum_n coefs[n] * (clip(T, tmin, tmax) - tref)^n; corrected = reading - bias(T)"
 
 
@@ -87,11 +88,14 @@ def from_document(doc: dict, path="file") -> ThermalBias:
         raise FileFormatError(f"{path}: {exc}") from None
 
 
+register(ThermalBias)
+
+
 def save_thermal_bias(tb: ThermalBias, path: str | os.PathLike) -> None:
     """Write `tb` as versioned JSON, atomically."""
-    write_json(path, to_document(tb))
+    save(tb, path)
 
 
 def load_thermal_bias(path: str | os.PathLike) -> ThermalBias:
     """Read and validate a ``gyrocal.thermal-bias`` file."""
-    return from_document(read_json(path), path)
+    return load(path, ThermalBias)

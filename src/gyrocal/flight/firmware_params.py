@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import __version__
+from .._version import __version__
 from ..errors import InputError
 from .thermal_bias import MAX_ORDER, ThermalBias
 
@@ -68,12 +68,13 @@ def px4_params(tb: ThermalBias, *, instance: int = 0, device_id: int | None = No
         Default: the id recorded from a ULog; required otherwise.
     """
     if not 0 <= int(instance) <= 3:
-        raise InputError(f"instance={instance!r}: PX4 has gyro thermal slots TC_G0..TC_G3")
+        raise InputError(f"{{param}}={instance!r}: PX4 has gyro thermal slots TC_G0..TC_G3", param="slot",
+                         value=instance)
     dev = device_id if device_id is not None else tb.source.get("device_id")
     if dev is None:
         raise InputError("PX4 applies TC_G parameters only to the gyro whose device id is TC_Gi_ID, and this fit "
-                         "records none (not read from a ULog): give the id (the CAL_GYROn_ID value) with device_id "
-                         "(CLI --device-id)")
+                         "records none (it was not read from a ULog)", param="device_id",
+                         hint="give the id (the CAL_GYROn_ID value) with {param}")
     i = int(instance)
     tref = float(np.float32(round(tb.tref, 2)))
     coefs = tb.coefficients_about(tref)
@@ -108,7 +109,8 @@ def ardupilot_params(tb: ThermalBias, *, imu: int = 1, caltemp: float | None = N
         middle of the fitted range.
     """
     if not 1 <= int(imu) <= 3:
-        raise InputError(f"imu={imu!r}: ArduPilot has temperature calibration sets INS_TCAL1..INS_TCAL3")
+        raise InputError(f"{{param}}={imu!r}: ArduPilot has temperature calibration sets INS_TCAL1..INS_TCAL3",
+                         param="slot", value=imu)
     n = int(imu)
     tcal = float(np.float32(tb.tref if caltemp is None else caltemp))
     c35 = tb.coefficients_about(ARDUPILOT_TREF)

@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
@@ -84,6 +85,23 @@ class ThermalBias:
     fit: dict = field(default_factory=dict)
     source: dict = field(default_factory=dict)
     warnings: tuple[str, ...] = ()
+
+    #: File kind (registered by :mod:`.bias_file`, which holds the document code).
+    FORMAT: ClassVar[str] = "gyrocal.thermal-bias"
+    VERSION: ClassVar[int] = 1
+
+    def to_document(self) -> dict:
+        """The JSON-ready document (``format: gyrocal.thermal-bias``)."""
+        from .bias_file import to_document
+
+        return to_document(self)
+
+    @classmethod
+    def from_document(cls, doc: dict, path="document") -> "ThermalBias":
+        """Validate a document and rebuild the fit, naming any bad field."""
+        from .bias_file import from_document
+
+        return from_document(doc, path)
 
     def __post_init__(self):
         k = MAX_ORDER + 1
@@ -192,7 +210,8 @@ def fit_thermal_bias(gyro, temp, sample_rate: float, *, max_order: int = MAX_ORD
         raise InputError(f"temp has {len(t_raw)} samples but gyro has {len(g)}")
     fs = positive("sample_rate", sample_rate)
     if not 0 <= int(max_order) <= MAX_ORDER:
-        raise InputError(f"max_order must be 0..{MAX_ORDER} (PX4 and ArduPilot evaluate cubics), got {max_order!r}")
+        raise InputError(f"{{param}} must be 0..{MAX_ORDER} (PX4 and ArduPilot evaluate cubics), got {max_order!r}",
+                         param="max_order", value=max_order)
     _check_input(g, t_raw, fs, min_span)
     size = max(10, int(round(block_s * fs)))
     course = temperature_course(t_raw, fs)

@@ -33,13 +33,16 @@ import math
 
 import numpy as np
 
-from .. import __version__
+from .._version import __version__
 from ..errors import InputError
 from ..noise import BI_FACTOR, NoiseReport
 
 __all__ = ["imu_utils_yaml", "kalibr_yaml", "vins_yaml", "vio_values"]
 
 _SENSOR = 3  # row of the sensor figures
+#: Kalibr's name -> the parameter that gives it.
+_PARAM = {"accelerometer_noise_density": "accel_noise_density", "accelerometer_random_walk": "accel_random_walk",
+          "gyroscope_random_walk": "gyro_random_walk"}
 
 
 def _walk(sensor, name: str, given: float | None, use_bound: bool) -> tuple[float, str]:
@@ -52,9 +55,9 @@ def _walk(sensor, name: str, given: float | None, use_bound: bool) -> tuple[floa
     bound = float(sensor.random_walk_bound[_SENSOR])
     if use_bound and math.isfinite(bound):
         return bound, "not seen in the log: its 95 % upper bound from the longest averaging times"
-    raise InputError(f"the {sensor.kind} random walk is not seen in this log (the Allan deviation never turns up); "
-                     f"log longer, give it ({name}), or use its 95 % upper bound {bound:.3g} (use_bound, CLI "
-                     "--random-walk-bound)")
+    raise InputError(f"the {sensor.kind} random walk is not seen in this log (the Allan deviation never turns up)",
+                     param="use_bound", hint=f"log longer, give it ({name}), or use its 95 % upper bound {bound:.3g} "
+                                             "({param})")
 
 
 def vio_values(report: NoiseReport, *, inflate: float = 1.0, accel_noise_density: float | None = None,
@@ -67,13 +70,13 @@ def vio_values(report: NoiseReport, *, inflate: float = 1.0, accel_noise_density
     times `inflate`.
     """
     if not (math.isfinite(inflate) and inflate >= 1):
-        raise InputError(f"inflate must be a factor >= 1, got {inflate!r}")
+        raise InputError(f"{{param}} must be a factor >= 1, got {inflate!r}", param="inflate", value=inflate)
     a = report.accel
     if a is None and (accel_noise_density is None or accel_random_walk is None):
-        raise InputError("the noise file has no accelerometer figures, and VIO tools need them: run gyrocal noise on "
-                         "a log with ax, ay, az columns, or give both accelerometer values (accel_noise_density "
-                         "[m/s^2/sqrt(Hz)] and accel_random_walk [m/s^3/sqrt(Hz)]; CLI --accel-noise-density, "
-                         "--accel-random-walk)")
+        raise InputError("the noise file has no accelerometer figures, and VIO tools need them",
+                         param="accel_noise_density",
+                         hint="run gyrocal noise on a log with ax, ay, az columns (and the accelerometer's unit), or "
+                              "give both {param} [m/s^2/sqrt(Hz)] and the random walk [m/s^3/sqrt(Hz)]")
     g = report.gyro
     d = g.density
     out = {"gyroscope_noise_density": (float(d.value[_SENSOR]), f"Allan -1/2 line at tau = {d.tau[_SENSOR]:.4g} s, "
@@ -88,14 +91,15 @@ def vio_values(report: NoiseReport, *, inflate: float = 1.0, accel_noise_density
     out["accelerometer_random_walk"] = _walk(a, "accel_random_walk", accel_random_walk, use_bound)
     for key, (value, note) in out.items():
         if not (math.isfinite(value) and value > 0):
-            raise InputError(f"{key} must be > 0, got {value!r}")
+            raise InputError(f"{key} must be > 0, got {value!r}", param=_PARAM.get(key), value=value)
         out[key] = (value * inflate, note)
     return out
 
 
 def _source_lines(report: NoiseReport, inflate: float) -> list[str]:
     src = report.source.get("file", "a log")
-    return [f"# written by gyrocal {__version__} from {src}: {report.duration:.0f} s at rest, {report.sample_rate:g} Hz",
+    return [f"# written by gyrocal {__version__} from {src}: {report.duration:.0f} s at rest, "
+            f"{report.sample_rate:g} Hz",
             f"# inflate: {inflate:g} (every noise value below is the measured one times this safety factor)"]
 
 
@@ -105,7 +109,7 @@ def kalibr_yaml(report: NoiseReport, *, rostopic: str = "/imu0", update_rate: fl
     v = vio_values(report, inflate=inflate, **given)
     rate = report.sample_rate if update_rate is None else float(update_rate)
     if not (math.isfinite(rate) and rate > 0):
-        raise InputError(f"update_rate must be > 0 Hz, got {update_rate!r}")
+        raise InputError(f"{{param}} must be > 0 Hz, got {update_rate!r}", param="update_rate", value=update_rate)
     units = {"accelerometer_noise_density": "m/s^2/sqrt(Hz)", "accelerometer_random_walk": "m/s^3/sqrt(Hz)",
              "gyroscope_noise_density": "rad/s/sqrt(Hz)", "gyroscope_random_walk": "rad/s^2/sqrt(Hz)"}
     lines = _source_lines(report, inflate)
@@ -148,7 +152,7 @@ def _imu_utils_block(sensor, short: str, unit: str, inflate: float) -> list[str]
 def imu_utils_yaml(report: NoiseReport, *, name: str = "imu", inflate: float = 1.0) -> str:
     """imu_utils' ``<name>_imu_param.yaml`` layout (``Acc`` left out when the log has no accelerometer)."""
     if not (math.isfinite(inflate) and inflate >= 1):
-        raise InputError(f"inflate must be a factor >= 1, got {inflate!r}")
+        raise InputError(f"{{param}} must be a factor >= 1, got {inflate!r}", param="inflate", value=inflate)
     lines = ["%YAML:1.0", *_source_lines(report, inflate),
              "# *_n: Allan deviation at tau = 1 s (white-noise density); *_w: minimum of the Allan deviation",
              "---", "type: IMU", f"name: {name}"]

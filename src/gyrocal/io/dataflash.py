@@ -137,5 +137,5 @@ def read_dataflash_columns(path: str | os.PathLike) -> dict[int, tuple[dict, dic
                 "ax": acc[:, 0], "ay": acc[:, 1], "az": acc[:, 2]}
         if np.isfinite(temp).all():
             data["temp"] = temp
-        out[inst] = (data, {}, {"imu": n, "undone": undone, "duplicates": int(len(raw) - len(a))})
+        out[inst] = (data, {}, {"imu_number": n, "undone": undone, "duplicates": int(len(raw) - len(a))})
     return out

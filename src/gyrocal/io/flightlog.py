@@ -34,10 +34,11 @@ def _choose(instances: dict, imu: int | None, source: str) -> int:
         if len(instances) == 1:
             return next(iter(instances))
         listed = ", ".join(f"{i}{_label(info)}" for i, (_, _, info) in sorted(instances.items()))
-        raise InputError(f"{source}: {len(instances)} IMUs in this log ({listed}); choose one with imu= "
-                         "(CLI --imu N)")
+        raise InputError(f"{source}: {len(instances)} IMUs in this log ({listed})", param="imu",
+                         hint="choose one with {param} N")
     if imu not in instances:
-        raise InputError(f"{source}: no IMU {imu}; the log holds {', '.join(map(str, sorted(instances)))}")
+        raise InputError(f"{source}: no IMU {imu}; the log holds {', '.join(map(str, sorted(instances)))}",
+                         param="imu", value=imu)
     return imu
 
 
@@ -46,7 +47,8 @@ def _label(info: dict) -> str:
 
 
 def read_flight_log(path: str | os.PathLike, *, imu: int | None = None, units: str | None = "rad/s",
-                    check_units: bool = True, saturation: SaturationPolicy = "error") -> tuple[Recording, dict]:
+                    check_units: bool = True, saturation: SaturationPolicy = "error",
+                    accel_units: str | None = None) -> tuple[Recording, dict]:
     """One IMU of a PX4 ULog or an ArduPilot DataFlash log, and what the log says about it.
 
     Parameters
@@ -57,17 +59,23 @@ def read_flight_log(path: str | os.PathLike, *, imu: int | None = None, units: s
         Instance (PX4 ``multi_id``, ArduPilot ``I``, both from 0); needed when there are several.
     units : {"rad/s", None}
         Both firmwares log rad/s; any other declared unit is refused.
+    accel_units : {"m/s^2", None}
+        Read the accelerometer too (both firmwares log m/s^2); without it, it is not read.
 
     Returns
     -------
     recording : Recording
     info : dict
-        ``format``, ``imu`` and the reader's notes (PX4 ``device_id``; ArduPilot corrections undone).
+        ``format``, ``instance`` and the reader's notes (PX4 ``device_id``; ArduPilot ``imu_number``
+        (1 for the first IMU) and the corrections undone).
     """
     path = Path(path)
     if units not in (None, "rad/s"):
-        raise UnitError(f"{path.name}: PX4 and ArduPilot log gyro rates in rad/s; drop units={units!r} (CLI --units "
-                        "rad/s)")
+        raise UnitError(f"{path.name}: PX4 and ArduPilot log gyro rates in rad/s, not {units}", param="units",
+                        value=units, hint="give {param} rad/s")
+    if accel_units not in (None, "m/s^2"):
+        raise UnitError(f"{path.name}: PX4 and ArduPilot log accelerations in m/s^2, not {accel_units}",
+                        param="accel_units", value=accel_units, hint="give {param} m/s^2")
     kind = flight_log_kind(path)
     if kind == "ulog":
         from .ulog import read_ulog_columns
@@ -81,6 +89,11 @@ def read_flight_log(path: str | os.PathLike, *, imu: int | None = None, units: s
         raise InputError(f"{path.name}: neither a PX4 ULog nor an ArduPilot DataFlash log")
     chosen = _choose(instances, imu, path.name)
     data, extra, info = instances[chosen]
+    if accel_units is None:
+        data = {k: v for k, v in data.items() if k not in ("ax", "ay", "az")}
+    elif "ax" not in data:
+        raise InputError(f"{path.name}: IMU {chosen} has no accelerometer data in this log", param="accel_units",
+                         hint="leave out {param}")
     rec = build_recording(data, extra, source=f"{path.name} IMU {chosen}", units="rad/s", check_units=check_units,
-                          saturation=saturation)
-    return rec, {"format": kind, "imu": chosen, **info}
+                          saturation=saturation, accel_units=accel_units)
+    return rec, {"format": kind, "instance": chosen, **info}

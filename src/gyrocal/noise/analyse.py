@@ -10,11 +10,10 @@ would join different bias levels with steps that read as noise.
 from __future__ import annotations
 
 import warnings
-from typing import Literal
-
 import numpy as np
 
 from .._validation import finite_array, positive
+from ..choices import MotionPolicy, values
 from ..errors import GyrocalWarning, InputError, UnitError
 from ..recording import Recording
 from ..stillness import find_motion
@@ -24,7 +23,6 @@ from .report import NoiseReport, SensorNoise
 
 __all__ = ["MotionPolicy", "NoiseWarning", "characterise", "characterise_recording"]
 
-MotionPolicy = Literal["restrict", "refuse"]
 #: The shortest still stretch a log that moves is cut to [s]; shorter ones are refused.
 MIN_STILL_S = 10.0
 #: Fewer distinct readings than this on an axis: quantisation, not noise, shapes the short-tau curve.
@@ -87,8 +85,9 @@ def characterise(gyro, sample_rate: float, *, accel=None, motion: MotionPolicy =
     if a is not None and len(a) != len(g):
         raise InputError(f"accel has {len(a)} samples but gyro has {len(g)}")
     fs = positive("sample_rate", sample_rate)
-    if motion not in ("restrict", "refuse"):
-        raise InputError(f"motion={motion!r} is not one of restrict, refuse")
+    if motion not in values(MotionPolicy):
+        raise InputError(f"{{param}}={motion!r} is not one of {', '.join(values(MotionPolicy))}", param="motion",
+                         value=motion)
     found: list[str] = []
     _check_axes("gyro", g, ("x", "y", "z"), found)
     if a is not None:
@@ -104,7 +103,7 @@ def characterise(gyro, sample_rate: float, *, accel=None, motion: MotionPolicy =
                              f"{MIN_STILL_S:g} s: record it lying still, untouched")
         if motion == "refuse":
             raise InputError(f"{what}: record the sensor lying still, untouched, or analyse only the longest "
-                             f"still stretch, {(stop - start) / fs:.1f} s (motion='restrict', CLI --motion restrict)")
+                             f"still stretch, {(stop - start) / fs:.1f} s ({{param}} restrict)", param="motion")
         found.append(f"{what}: analysed the longest still stretch, {start / fs:.1f}-{stop / fs:.1f} s "
                      f"({(stop - start) / fs:.1f} s of {len(g) / fs:.1f} s)")
     for message in found:
@@ -123,8 +122,8 @@ def characterise_recording(rec: Recording, *, motion: MotionPolicy = "restrict",
     Raw counts are refused: noise figures need a physical unit (give the sensitivity).
     """
     if rec.units != "rad/s":
-        raise UnitError("noise figures need physical units, but the gyro is in raw counts: give the sensitivity "
-                        "(LSB per output unit) so the counts become a rate")
+        raise UnitError("noise figures need physical units, but the gyro is in raw counts", param="sensitivity",
+                        hint="give {param} (LSB per output unit) so the counts become a rate")
     accel = getattr(rec, "accel", None)
     info = {"gyro_units": rec.source_units, **(source or {})}
     if accel is not None:

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .._jsonfile import read_json, write_json
 from ..errors import InputError
-from .report import NoiseReport, from_document, to_document
+from ..files import load, save
+from .report import NoiseReport
 
 __all__ = ["load_noise", "noise_density_arg", "save_noise"]
 
@@ -19,7 +19,7 @@ _DEG_SUFFIXES = ("deg/s/rthz", "deg/s/sqrt(hz)", "dps/rthz", "deg/s/√hz")
 
 def save_noise(path: str | os.PathLike, report: NoiseReport) -> None:
     """Write a noise report as JSON (atomically)."""
-    write_json(path, to_document(report))
+    save(report, path)
 
 
 def load_noise(path: str | os.PathLike) -> NoiseReport:
@@ -28,7 +28,7 @@ def load_noise(path: str | os.PathLike) -> NoiseReport:
     Every gyro density must be a number > 0: a zero density would make any
     uncertainty computed from it zero.
     """
-    return from_document(read_json(path), path)
+    return load(path, NoiseReport)
 
 
 def noise_density_arg(value: str) -> np.ndarray:

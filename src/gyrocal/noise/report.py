@@ -20,20 +20,21 @@ File layout (SI units, recorded in ``units``; ``null`` for a figure not seen)::
     }
 
 The sensor row is read from the root of the three axes' mean Allan variance. Version 1
-files (gyro only, no intervals) are read through :func:`upgrade_v1`.
+files (gyro only, no intervals) are upgraded by :func:`upgrade_v1` (through :mod:`gyrocal.legacy`).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import ClassVar, Literal
 
 import numpy as np
 
-from .. import __version__
 from .._jsonfile import check_header, get
+from .._version import __version__
 from ..errors import FileFormatError, InputError
+from ..files import register
 from .allan import ONE_SIGMA
 from .figures import ROWS, Figure
 
@@ -101,6 +102,7 @@ class SensorNoise:
         return self.density.value * math.sqrt(sample_rate)
 
 
+@register
 @dataclass(frozen=True)
 class NoiseReport:
     """Noise figures of a log at rest: the gyro's, and the accelerometer's when it was logged.
@@ -138,6 +140,18 @@ class NoiseReport:
     confidence: float = ONE_SIGMA
     source: dict = field(default_factory=dict)
     warnings: tuple[str, ...] = ()
+
+    FORMAT: ClassVar[str] = FORMAT
+    VERSION: ClassVar[int] = VERSION
+
+    def to_document(self) -> dict:
+        """The JSON-ready document (``format: gyrocal.noise``)."""
+        return to_document(self)
+
+    @classmethod
+    def from_document(cls, doc: dict, path="document") -> "NoiseReport":
+        """Validate a current-version document (older ones come upgraded by :mod:`gyrocal.legacy`)."""
+        return from_document(doc, path)
 
     @property
     def duration(self) -> float:
@@ -222,8 +236,6 @@ def _sensor_from(doc: dict, key: SensorKind, path) -> SensorNoise:
 
 def from_document(doc: dict, path="file") -> NoiseReport:
     """Validate a version 2 document and rebuild the report, naming any bad field."""
-    if doc.get("version") == 1:
-        doc = upgrade_v1(doc, path)
     check_header(doc, path, FORMAT, (VERSION,))
     analysed = get(doc, "analysed", path)
     try:

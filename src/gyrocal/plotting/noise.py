@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from ._mpl import new_figure
+from .figure import new_figure
 
 __all__ = ["allan_deviation_plot", "allan_figure"]
 
@@ -50,8 +50,8 @@ def allan_deviation_plot(ax, sensor, *, axes: str = "xyz", unit: str | None = No
                               linestyle="--", linewidth=0.9)
             art["random_walk"].append(rw)
         if math.isfinite(sensor.bias_instability.value[a]):
-            (bias,) = ax.loglog([sensor.bias_instability.tau[a]], [factor * sensor.bias_instability.value[a] * BI_FACTOR],
-                                marker="o", color=color, linestyle="none")
+            floor = factor * sensor.bias_instability.value[a] * BI_FACTOR
+            (bias,) = ax.loglog([sensor.bias_instability.tau[a]], [floor], marker="o", color=color, linestyle="none")
             art["bias"].append(bias)
     ax.set_xlabel("averaging time tau [s]")
     ax.set_ylabel(f"{sensor.kind} Allan deviation [{label}]")

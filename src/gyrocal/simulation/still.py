@@ -20,7 +20,10 @@ from ..errors import InputError
 from ..recording import Recording
 from .gyro import VirtualGyro
 
-__all__ = ["BiasDrift", "StillProtocol", "simulate_still"]
+__all__ = ["BiasDrift", "StillAccelerometer", "StillProtocol", "simulate_still"]
+
+#: Standard gravity [m/s^2], along +z of a board lying flat.
+GRAVITY = 9.80665
 
 
 @dataclass(frozen=True)
@@ -99,9 +102,40 @@ class StillProtocol:
         return self.temp_end - (self.temp_end - self.temp_start) * np.exp(-t / self.temp_tau)
 
 
-def simulate_still(gyro: VirtualGyro, protocol: StillProtocol, *, sample_rate: float,
-                   rng: np.random.Generator) -> tuple[Recording, np.ndarray]:
-    """Record `gyro` lying still through `protocol`.
+@dataclass(frozen=True)
+class StillAccelerometer:
+    """An accelerometer lying flat: gravity on +z, white noise and a random-walk bias.
+
+    Parameters
+    ----------
+    noise_density : float
+        White-noise density [m/s^2/sqrt(Hz)] (velocity random walk).
+    random_walk : float
+        Bias random walk [m/s^3/sqrt(Hz)] (Kalibr's ``accelerometer_random_walk``).
+    """
+
+    noise_density: float = 0.0
+    random_walk: float = 0.0
+
+    def __post_init__(self):
+        for name in ("noise_density", "random_walk"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0):
+                raise InputError(f"{name} must be >= 0, got {value!r}")
+
+    def measure(self, n: int, sample_rate: float, rng: np.random.Generator) -> np.ndarray:
+        """Readings (n, 3) [m/s^2]."""
+        a = np.zeros((n, 3))
+        a[:, 2] = GRAVITY
+        a += rng.standard_normal((n, 3)) * self.noise_density * math.sqrt(sample_rate)
+        if self.random_walk > 0:
+            a += np.cumsum(rng.standard_normal((n, 3)) * self.random_walk / math.sqrt(sample_rate), axis=0)
+        return a
+
+
+def simulate_still(gyro: VirtualGyro, protocol: StillProtocol, *, sample_rate: float, rng: np.random.Generator,
+                   accel: StillAccelerometer | None = None) -> tuple[Recording, np.ndarray]:
+    """Record `gyro` (and `accel`, when given) lying still through `protocol`.
 
     Returns
     -------
@@ -120,4 +154,6 @@ def simulate_still(gyro: VirtualGyro, protocol: StillProtocol, *, sample_rate: f
     reading = true_temp + rng.standard_normal(n) * protocol.temp_noise
     if protocol.temp_quantum is not None:
         reading = np.round(reading / protocol.temp_quantum) * protocol.temp_quantum
-    return Recording(t=t, gyro=m, sample_rate=fs, temp=reading), true_temp
+    fields = {} if accel is None else {"accel": accel.measure(n, fs, rng), "accel_units": "m/s^2",
+                                       "accel_source_units": "m/s^2"}
+    return Recording(t=t, gyro=m, sample_rate=fs, temp=reading, **fields), true_temp
