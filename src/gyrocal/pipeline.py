@@ -27,8 +27,7 @@ from .errors import InputError
 from .estimators import FitResult, make_estimator
 from .observations import Observation, ObservationSet, observe
 from .recording import Recording
-from .segmentation import Segmentation, segment
-from .segmentation._motion import static_level
+from .segmentation import Segmentation, segment, static_level
 from .units import parse_input_unit, parse_rate_unit, unit_factor
 from .windows import Window
 

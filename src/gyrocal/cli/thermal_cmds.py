@@ -148,7 +148,7 @@ def thermal_report(
     """Compare uncompensated, traditional, Lagrange and smooth compensation on a test recording."""
     from ..files import load_thermal
     from ..thermal.evaluate import evaluate
-    from ..thermal.report import write_report
+    from ..thermal_report import write_report
 
     check_output(output, inputs=(calibration, test), folder=True)
     cal = load_thermal(calibration)
