@@ -136,7 +136,6 @@ def test_utf16_and_utf32_text_with_a_bom_is_decoded(tmp_path, use_pyarrow, encod
 
 
 def test_cli_refuses_each_in_one_line(tmp_path, rng):
-    pytest.importorskip("typer")
     from cli_runner import refused
 
     g = rng.normal(0, 2.0, (50, 3))

@@ -2,8 +2,8 @@
 
 ``calibrate`` is what the ``gyrocal calibrate`` command runs. With a known speed the
 rotation windows are the constant-speed plateaus and their reference is the speed; with
-a known angle they are whole turns and their reference is ``angle / duration`` (SPEC,
-Method S, first-moment form). A windows file overrides detection.
+a known angle they are whole turns and their reference is ``angle / duration`` (docs/core.md,
+Estimators, first-moment form). A windows file overrides detection.
 
 Which windows each method uses:
 
@@ -75,7 +75,7 @@ class CalibrationRun:
         return rows
 
     def scale_bias_note(self) -> str | None:
-        """For the paper's mean-of-squares methods, how low they read k (SPEC); None otherwise."""
+        """For the paper's mean-of-squares methods, how low they read k (docs/core.md, Accuracy); None otherwise."""
         fit = self.fit
         if self.calibration.method == "first-moment" or fit.noise_std is None:
             return None

@@ -8,8 +8,8 @@ from typing import Literal
 import numpy as np
 
 from ._arrays import readonly
-from .choices import AccelUnit, values
 from ._validation import finite_array, positive
+from .choices import AccelUnit, values
 from .errors import InputError
 
 __all__ = ["Recording"]

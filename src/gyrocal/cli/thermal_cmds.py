@@ -99,10 +99,10 @@ def thermal(
 def _print_table(cal, fit) -> None:
     import numpy as np
     from rich.box import SIMPLE
-
-    from ..units import unit_factor
     from rich.markup import escape
     from rich.table import Table
+
+    from ..units import unit_factor
 
     user = cal.kg_user
     std = cal.to_user(cal.std)  # 1-sigma in the table's units; below, the largest of each group of terms

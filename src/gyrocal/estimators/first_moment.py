@@ -1,4 +1,4 @@
-"""The first-moment estimator (SPEC, Method S): unbiased, with a data-driven covariance.
+"""The first-moment estimator (docs/core.md, Estimators): unbiased, with a data-driven covariance.
 
 Rotation windows give norm equations on the window mean,
 
@@ -178,7 +178,8 @@ def _noise_var(obs: ObservationSet, noise_var) -> np.ndarray:
 def _lm_fit(obs: ObservationSet, nv: np.ndarray, max_iter: int) -> BatchFit:
     """The general path: Levenberg–Marquardt from the per-axis linear start."""
     p0 = initial_guess(obs)
-    fun = lambda p: residuals_and_jacobian(p, obs)[:2]
+    def fun(p):
+        return residuals_and_jacobian(p, obs)[:2]
     p, iterations, converged, residuals, history = batched_lm(fun, p0, max_iter=max_iter)
     require_converged(converged, iterations, "first-moment least squares")
     # The norm equations cannot see the sign of k; a positive scale is the physical one.

@@ -10,10 +10,9 @@ from .._validation import positive
 from ..choices import AccelUnit, SaturationPolicy, values
 from ..errors import InputError, NonFiniteInputError, SaturationError, UnitError
 from ..recording import Recording
+from ..saturation import find_saturation, stuck_runs
 from ..units import parse_input_unit, parse_rate_unit, unit_factor
 from ._columns import ACCEL, NUMERIC
-from ..saturation import find_saturation, stuck_runs
-
 
 #: No MEMS gyro measures beyond about 2000 deg/s (4000 for a few); above this, rad/s is a unit mistake.
 MAX_PLAUSIBLE_RAD_S = math.radians(2000.0)
