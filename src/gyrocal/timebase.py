@@ -1,0 +1,198 @@
+"""The time base of a recording: nominal rate, jitter, delayed deliveries and real gaps.
+
+Logs stamped when a PC *receives* the samples come in bursts: the steps alternate short and
+long (for example 3 ms and 17 ms around a 10 ms sensor clock), and a late packet is a long
+step followed by a burst of short ones. The sensor clock stays regular under all this, so:
+
+* the nominal period is the mean step of the regular clock, found robustly as the median of
+  block-mean steps (a block of 64 steps averages bursts away; the median ignores the few
+  blocks that hold a gap), never the median of the single steps;
+* a long step is a **real gap** only when samples are missing: the clock residual
+  ``t_i - i P`` (its lower envelope, the least-delayed samples) jumps by at least half a
+  period across it and stays there. A delayed delivery makes the residual rise and fall
+  back within the burst, and loses nothing.
+
+Angles are then integrals on the actual stamps (trapezoid weights, see
+:func:`gyrocal.observations.observe`); a turn that straddles a real gap has lost angle that
+no stamp can give back.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import InputError
+
+__all__ = ["Gap", "TimeBase", "analyse_time", "nominal_period"]
+
+_BLOCK = 64  # steps per block of the robust period estimate
+_ENVELOPE = 50  # samples each side over which the clock residual's lower envelope is taken
+#: Steps below this multiple of the period cannot hide a lost sample and are not examined.
+_CANDIDATE_STEP = 1.5
+
+
+def nominal_period(t: np.ndarray) -> float:
+    """Period of the sensor clock [s]: the median of block-mean steps of up to `_BLOCK` steps.
+
+    Equal to the mean step ``span / (N - 1)`` for a log without gaps, whatever its jitter,
+    and unaffected by a few gaps (they move only the blocks that hold them).
+    """
+    t = np.asarray(t, dtype=float)
+    n = len(t) - 1
+    if n < 1:
+        raise InputError(f"a time base needs at least two samples, got {len(t)}")
+    block = min(_BLOCK, max(1, n // 8))
+    if n < 2 * block:
+        return float(t[-1] - t[0]) / n
+    ends = t[::block]
+    return float(np.median(np.diff(ends))) / block
+
+
+@dataclass(frozen=True)
+class Gap:
+    """Samples missing from a log: the step ``t[index - 1] -> t[index]`` lost `lost` samples.
+
+    Attributes
+    ----------
+    index : int
+        First sample after the gap.
+    step : float
+        The long step [s].
+    lost : int
+        Samples missing, from the jump of the regular clock.
+    """
+
+    index: int
+    step: float
+    lost: int
+
+
+@dataclass(frozen=True)
+class TimeBase:
+    """Facts about a recording's time stamps.
+
+    Attributes
+    ----------
+    n : int
+        Samples.
+    span : float
+        ``t[-1] - t[0]`` [s].
+    period : float
+        Nominal period of the sensor clock [s] (:func:`nominal_period`).
+    mean_step, median_step : float
+        Mean and median of the single steps [s].
+    jitter : float
+        Standard deviation of the single steps, gaps left out [s].
+    delayed : int
+        Long steps (over 1.5 periods) that lost no sample: late deliveries caught up by a burst.
+    gaps : tuple of Gap
+        Real gaps (samples missing).
+    has_time : bool
+        Whether the stamps came from the data (False: built from a declared rate).
+    """
+
+    n: int
+    span: float
+    period: float
+    mean_step: float
+    median_step: float
+    jitter: float
+    delayed: int
+    gaps: tuple[Gap, ...]
+    has_time: bool = True
+
+    @property
+    def sample_rate(self) -> float:
+        """Nominal rate [Hz]."""
+        return 1.0 / self.period
+
+    @property
+    def lost(self) -> int:
+        """Samples missing in all gaps."""
+        return sum(g.lost for g in self.gaps)
+
+    @property
+    def bursty(self) -> bool:
+        """Whether the single steps scatter by more than 10 % of the period (receive-time stamps)."""
+        return self.jitter > 0.1 * self.period
+
+    def gaps_in(self, start: int, stop: int) -> tuple[Gap, ...]:
+        """Gaps between samples ``start`` and ``stop - 1`` (inside a window ``start:stop``)."""
+        return tuple(g for g in self.gaps if start < g.index < stop)
+
+    def describe(self) -> list[str]:
+        """Plain lines for people: rate, steps, jitter, delayed deliveries and gaps."""
+        ms = 1e3
+        if not self.has_time:
+            return [f"time base: no time column; {self.sample_rate:.6g} Hz as declared, {self.n} samples"]
+        lines = [
+            f"time base: {self.sample_rate:.6g} Hz nominal (mean step of the sensor clock); "
+            f"steps mean {self.mean_step * ms:.4g} ms, median {self.median_step * ms:.4g} ms, "
+            f"jitter {self.jitter * ms:.3g} ms"
+        ]
+        if self.bursty:
+            lines.append("  steps are bursty (receive-time stamps?): angles are integrated on the stamps and the "
+                         "rate is the mean one, never the median step")
+        if self.delayed:
+            lines.append(f"  {self.delayed} late deliveries (a long step caught up by a burst; no sample lost)")
+        if self.gaps:
+            worst = max(self.gaps, key=lambda g: g.lost)
+            lines.append(f"  {len(self.gaps)} gap(s), {self.lost} sample(s) missing; longest {worst.step * ms:.4g} ms "
+                         f"at sample {worst.index} ({worst.lost} lost): turns across a gap are left out")
+        return lines
+
+
+def _envelope(r: np.ndarray, size: int, forward: bool) -> np.ndarray:
+    """Running minimum of `r` over the `size` samples from i on (forward) or up to i (backward)."""
+    from scipy.ndimage import minimum_filter1d
+
+    # minimum_filter1d centres its window; `origin` shifts it to one side
+    origin = -(size // 2) if forward else (size - 1) // 2
+    return minimum_filter1d(r, size, mode="nearest", origin=origin)
+
+
+def analyse_time(t, *, has_time: bool = True) -> TimeBase:
+    """Read the time base of stamps `t` [s] (strictly increasing).
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+        Sample times [s].
+    has_time : bool
+        Whether the stamps came from the data; a time base built from a declared rate is
+        regular but may still hold gaps (rows dropped for saturation).
+    """
+    t = np.asarray(t, dtype=float)
+    if t.ndim != 1 or len(t) < 2:
+        raise InputError(f"a time base needs at least two sample times, got shape {t.shape}")
+    step = np.diff(t)
+    period = nominal_period(t)
+    candidates = np.flatnonzero(step > _CANDIDATE_STEP * period)
+    gaps: list[Gap] = []
+    if len(candidates):
+        # clock residual against the regular clock; its lower envelope holds the least-delayed samples
+        r = t - t[0] - period * np.arange(len(t))
+        size = min(_ENVELOPE, len(t))
+        after = _envelope(r, size, forward=True)[candidates + 1]
+        before = _envelope(r, size, forward=False)[candidates]
+        lost = np.rint((after - before) / period).astype(np.int64)
+        gaps = [Gap(int(i) + 1, float(step[i]), int(k)) for i, k in zip(candidates, lost) if k >= 1]
+    regular = np.ones(len(step), dtype=bool)
+    regular[[g.index - 1 for g in gaps]] = False
+    kept = step[regular] if regular.any() else step
+    sample = kept[np.linspace(0, len(kept) - 1, min(len(kept), 100_000)).astype(np.intp)]
+    return TimeBase(
+        n=len(t),
+        span=float(t[-1] - t[0]),
+        period=period,
+        mean_step=float(step.mean()),
+        median_step=float(np.median(sample)),
+        jitter=float(kept.std()) if len(kept) > 1 else 0.0,
+        delayed=int(len(candidates) - len(gaps)),
+        gaps=tuple(gaps),
+        has_time=has_time,
+    )
+
