@@ -32,6 +32,8 @@ _BLOCK = 64  # steps per block of the robust period estimate
 _ENVELOPE = 50  # samples each side over which the clock residual's lower envelope is taken
 #: Steps below this multiple of the period cannot hide a lost sample and are not examined.
 _CANDIDATE_STEP = 1.5
+#: A step this many periods long that lost nothing is a late delivery (shorter ones are jitter).
+_LATE_STEP = 3.0
 
 
 def nominal_period(t: np.ndarray) -> float:
@@ -87,11 +89,17 @@ class TimeBase:
     jitter : float
         Standard deviation of the single steps, gaps left out [s].
     delayed : int
-        Long steps (over 1.5 periods) that lost no sample: late deliveries caught up by a burst.
+        Long steps (over 3 periods) that lost no sample: late deliveries caught up by a burst.
     gaps : tuple of Gap
         Real gaps (samples missing).
     has_time : bool
         Whether the stamps came from the data (False: built from a declared rate).
+    regular_clock : bool
+        Whether the stamps follow a regular sensor clock (with its gaps) up to bounded delays:
+        the lower envelope of ``t_i - i P`` stays within half a period of a straight line. Then
+        :meth:`clock_times` rebuilds the sample times on that clock.
+    clock_start, clock_period : float
+        The regular clock ``t = clock_start + clock_period x (sample number, gaps counted)`` [s].
     """
 
     n: int
@@ -103,6 +111,9 @@ class TimeBase:
     delayed: int
     gaps: tuple[Gap, ...]
     has_time: bool = True
+    regular_clock: bool = False
+    clock_start: float = 0.0
+    clock_period: float = 0.0
 
     @property
     def sample_rate(self) -> float:
@@ -118,6 +129,23 @@ class TimeBase:
     def bursty(self) -> bool:
         """Whether the single steps scatter by more than 10 % of the period (receive-time stamps)."""
         return self.jitter > 0.1 * self.period
+
+    def clock_numbers(self) -> np.ndarray:
+        """Each sample's number on the sensor clock (N,): its index plus the samples lost before it."""
+        add = np.zeros(self.n)
+        for g in self.gaps:
+            add[g.index] += g.lost
+        return np.arange(self.n, dtype=float) + np.cumsum(add)
+
+    def clock_times(self) -> np.ndarray | None:
+        """Sample times [s] on the regular sensor clock, gaps included; None without a regular clock.
+
+        Receive-time stamps place a sample when it arrived, up to a late delivery's delay after it
+        was taken; during a ramp that misplaces rate. The sensor's own clock does not.
+        """
+        if not self.regular_clock:
+            return None
+        return self.clock_start + self.clock_period * self.clock_numbers()
 
     def gaps_in(self, start: int, stop: int) -> tuple[Gap, ...]:
         """Gaps between samples ``start`` and ``stop - 1`` (inside a window ``start:stop``)."""
@@ -154,6 +182,38 @@ def _envelope(r: np.ndarray, size: int, forward: bool) -> np.ndarray:
     return minimum_filter1d(r, size, mode="nearest", origin=origin)
 
 
+def _find_gaps(t: np.ndarray, step: np.ndarray, period: float) -> list[Gap]:
+    """Real gaps: long steps across which the lower envelope of the clock residual rises for good.
+
+    A first vectorised pass keeps the long steps whose envelope rises by half a period; those are
+    then confirmed in time order against the envelope with the gaps already found taken out, so
+    a burst's long step just after a real gap (or a second gap close behind one) is judged on its
+    own. A step must also be long enough to hold the samples it is said to have lost.
+    """
+    candidates = np.flatnonzero(step > _CANDIDATE_STEP * period)
+    if not len(candidates):
+        return []
+    r = t - t[0] - period * np.arange(len(t))  # clock residual; its envelope is the least-delayed samples
+    size = min(_ENVELOPE, len(t))
+    jump = _envelope(r, size, forward=True)[candidates + 1] - _envelope(r, size, forward=False)[candidates]
+    gaps: list[Gap] = []
+    index, total = [], []  # found gaps and the samples lost up to each
+    for i in candidates[jump >= 0.5 * period].tolist():
+        lo, hi = max(0, i - size + 1), min(len(t), i + 1 + size)
+        j = np.arange(lo, hi)
+        lost_before = np.zeros(hi - lo)
+        if index:
+            k = np.searchsorted(index, j, side="right")  # gaps at or before each sample
+            lost_before = np.where(k > 0, np.asarray(total)[np.maximum(k - 1, 0)], 0.0)
+        adj = r[lo:hi] - period * lost_before
+        lost = int(np.rint((adj[i + 1 - lo:].min() - adj[: i + 1 - lo].min()) / period))
+        if 1 <= lost <= int(np.rint(step[i] / period)):
+            gaps.append(Gap(i + 1, float(step[i]), lost))
+            index.append(i + 1)
+            total.append((total[-1] if total else 0) + lost)
+    return gaps
+
+
 def analyse_time(t, *, has_time: bool = True) -> TimeBase:
     """Read the time base of stamps `t` [s] (strictly increasing).
 
@@ -170,19 +230,12 @@ def analyse_time(t, *, has_time: bool = True) -> TimeBase:
         raise InputError(f"a time base needs at least two sample times, got shape {t.shape}")
     step = np.diff(t)
     period = nominal_period(t)
-    candidates = np.flatnonzero(step > _CANDIDATE_STEP * period)
-    gaps: list[Gap] = []
-    if len(candidates):
-        # clock residual against the regular clock; its lower envelope holds the least-delayed samples
-        r = t - t[0] - period * np.arange(len(t))
-        size = min(_ENVELOPE, len(t))
-        after = _envelope(r, size, forward=True)[candidates + 1]
-        before = _envelope(r, size, forward=False)[candidates]
-        lost = np.rint((after - before) / period).astype(np.int64)
-        gaps = [Gap(int(i) + 1, float(step[i]), int(k)) for i, k in zip(candidates, lost) if k >= 1]
+    gaps = _find_gaps(t, step, period)
     regular = np.ones(len(step), dtype=bool)
     regular[[g.index - 1 for g in gaps]] = False
     kept = step[regular] if regular.any() else step
+    base = TimeBase(len(t), float(t[-1] - t[0]), period, 0.0, 0.0, 0.0, 0, tuple(gaps))
+    clock = _fit_clock(t, base.clock_numbers(), period)
     sample = kept[np.linspace(0, len(kept) - 1, min(len(kept), 100_000)).astype(np.intp)]
     return TimeBase(
         n=len(t),
@@ -191,8 +244,29 @@ def analyse_time(t, *, has_time: bool = True) -> TimeBase:
         mean_step=float(step.mean()),
         median_step=float(np.median(sample)),
         jitter=float(kept.std()) if len(kept) > 1 else 0.0,
-        delayed=int(len(candidates) - len(gaps)),
+        delayed=int(np.count_nonzero(step > _LATE_STEP * period)) - sum(g.step > _LATE_STEP * period for g in gaps),
         gaps=tuple(gaps),
         has_time=has_time,
+        regular_clock=clock is not None,
+        clock_start=clock[0] if clock else float(t[0]),
+        clock_period=clock[1] if clock else period,
     )
+
+
+def _fit_clock(t: np.ndarray, k: np.ndarray, period: float) -> tuple[float, float] | None:
+    """``(start, period)`` of the regular clock under stamps `t` at clock numbers `k`, or None.
+
+    The lower envelope of ``t - k P`` (the least-delayed samples) is fitted by a line; the clock
+    is regular when the envelope stays within half a period of it.
+    """
+    from scipy.ndimage import minimum_filter1d
+
+    r = t - t[0] - period * k
+    env = minimum_filter1d(r, min(_ENVELOPE, len(t)), mode="nearest")
+    pick = np.linspace(0, len(t) - 1, min(len(t), 10_000)).astype(np.intp)
+    slope, icept = np.polyfit(k[pick], env[pick], 1)
+    resid = env - (icept + slope * k)
+    if float(resid.max() - resid.min()) >= 0.5 * period:
+        return None
+    return float(t[0] + icept), float(period + slope)
 

@@ -8,6 +8,7 @@ from ._result import BatchFit, FitResult, Method
 from .algorithm1 import Algorithm1, algorithm1_batch
 from .first_moment import FirstMoment, first_moment_batch
 from .paper_lm import PaperLM, paper_lm_batch
+from .residuals import window_residuals
 
 __all__ = [
     "Algorithm1",
@@ -20,6 +21,7 @@ __all__ = [
     "first_moment_batch",
     "make_estimator",
     "paper_lm_batch",
+    "window_residuals",
 ]
 
 

@@ -71,6 +71,13 @@ class ServoProtocol:
         Stops inside each turn (a hand turn done as several pieces).
     pause_length : float
         Length of each stop [s].
+    ripple : float
+        Amplitude of a sinusoidal speed ripple as a fraction of `speed` (a motor's or robot
+        joint's velocity ripple), in [0, 0.5]. It is a bounded angle error, faded in over the
+        ramps, so every turn still turns exactly its angle; the mean speed over a plateau
+        differs from the commanded one by up to ``ripple * speed / (pi * ripple_freq * T)``.
+    ripple_freq : float
+        Frequency of the ripple [Hz].
     """
 
     speed: float = math.radians(60.0)
@@ -86,6 +93,8 @@ class ServoProtocol:
     unevenness: float = 0.0
     pauses: int = 0
     pause_length: float = 0.3
+    ripple: float = 0.0
+    ripple_freq: float = 2.5
     _parsed: tuple[tuple[int, int], ...] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -104,6 +113,9 @@ class ServoProtocol:
         if np.any(~(waits >= 0)):
             raise InputError(f"wait must be >= 0 s, got {self.wait!r}")
         positive("vibration_freq", self.vibration_freq)
+        positive("ripple_freq", self.ripple_freq)
+        if not 0 <= self.ripple <= 0.5:
+            raise InputError(f"ripple must be in [0, 0.5] (a fraction of the speed), got {self.ripple!r}")
         if not 0 <= self.misalignment_deg <= 10:
             raise InputError(f"misalignment_deg must be in [0, 10] deg, got {self.misalignment_deg!r}")
         if not 0 <= self.unevenness <= 0.9:
@@ -183,6 +195,19 @@ def _trapezoid_angle(t: np.ndarray, speed: float, ramp: float, total: float) -> 
     return np.where(tc < ramp, up, np.where(tc > duration - ramp, down, mid)), duration
 
 
+def _ripple_angle(t: np.ndarray, p: ServoProtocol, ramp: float, duration: float, rng) -> np.ndarray:
+    """Angle error [rad] of a speed ripple at times `t`, zero at both ends of the piece.
+
+    The speed ripple ``ripple * speed * cos(2 pi f t + phase)`` integrates to a sinusoidal angle
+    error; it fades in over the ramp (half a ripple period without one) so the end angle is exact
+    and the plateau carries the full ripple.
+    """
+    f = p.ripple_freq
+    edge = ramp if ramp > 0 else 0.5 / f
+    fade = np.clip(np.minimum(t, duration - t) / edge, 0.0, 1.0)
+    return fade * p.ripple * p.speed / (2 * np.pi * f) * np.sin(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi))
+
+
 def _piece(p: ServoProtocol, total: float, fs: float, rng: np.random.Generator) -> tuple[np.ndarray, int, int]:
     """Rates of one turn piece [rad/s] (sign +), and the sample span of its plateau."""
     ramp = min(p.ramp, total / p.speed)  # a short piece never reaches a plateau longer than itself
@@ -203,6 +228,8 @@ def _piece(p: ServoProtocol, total: float, fs: float, rng: np.random.Generator) 
             2 * np.pi * p.vibration_freq * tb + rng.uniform(0, 2 * np.pi))
         random = p.vibration * p.speed / (2.0 * fs) * rng.standard_normal(n + 1)
         angle = angle + taper * (periodic + random)
+    if p.ripple > 0:
+        angle = angle + _ripple_angle(np.arange(n + 1) / fs, p, ramp, duration, rng)
     rates = np.diff(angle) * fs
     lo, hi = int(math.ceil(ramp * fs)), int(math.floor((duration - ramp) * fs))
     return rates, lo, max(hi, lo)
