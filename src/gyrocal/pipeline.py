@@ -34,7 +34,7 @@ from .segmentation import Segmentation, segment
 from .segmentation._motion import static_level
 from .timebase import TimeBase
 from .units import parse_input_unit, parse_rate_unit, unit_factor
-from .window_stats import observe_window
+from .window_stats import observe_window, pool_static_variance
 from .windows import Window
 
 __all__ = ["CalibrationRun", "calibrate"]
@@ -224,10 +224,12 @@ def calibrate(
         Unit of corrected rates; default the recording's unit, or deg/s for counts. For
         counts with a sensitivity it must be the unit the sensitivity refers to.
     checks : bool
-        Run the self-checks (default): turns across real gaps in the time stamps left out,
-        each window mean's own long-run variance, the paper's methods refusing varying rates,
-        goodness of fit with Birge scaling of the covariance, plausibility of k. ``False``
-        gives the plain estimate (benchmarks compare the two).
+        Run the self-checks (default): the sensor clock rebuilt under the time stamps and turns
+        across real gaps bounded or left out, plateau levels with their speed ripple regressed
+        out and each window mean's own long-run variance, the paper's methods refusing varying
+        rates, goodness of fit with Birge scaling of the covariance, plausibility of k.
+        ``False`` gives the plain estimate on the stamps as they are (benchmarks and tests
+        compare the two).
 
     Raises
     ------
@@ -266,7 +268,8 @@ def calibrate(
     if checks and not uses_static:
         require_constant_rate(rec, used, seg.baseline, method)
     observations = tuple(observe_window(rec, w, reference, value, long_run=checks and noise_std is None,
-                                        ripple=uses_static, times=times) for w in used)
+                                        ripple=uses_static and checks, times=times) for w in used)
+    observations = pool_static_variance(observations)
     if angle_var:  # turns across a time-stamp gap: their rate is known within the gap's bound
         observations = tuple(dataclasses.replace(o, rate_var=angle_var[(w.start, w.stop)] * o.rate**2)
                              if (w.start, w.stop) in angle_var else o for w, o in zip(used, observations))

@@ -102,8 +102,8 @@ def _common_cause(c: float, ctx: Context, k: np.ndarray) -> str:
     if ctx.reference == "angle":
         how = "short" if c > 1 else "long"
         ang = math.degrees(ctx.declared) if math.isfinite(ctx.declared) else None
-        time = ("is the sample rate {:.4g} Hz rather than {:.4g} Hz, or the time column in other units?"
-                if ctx.has_time else "is the sample rate {:.4g} Hz rather than the {:.4g} Hz declared?")
+        time = ("is the sample rate {:.3g} Hz rather than {:.4g} Hz, or the time column in other units?"
+                if ctx.has_time else "is the sample rate {:.3g} Hz rather than the {:.4g} Hz declared?")
         text = (f"every turn reads {100 * abs(1 - 1 / c):.0f} % {how} (k = {ks}, a common factor {c:.4g}): if the "
                 f"turns were as declared, the time base is off: " + time.format(ctx.sample_rate / c, ctx.sample_rate))
         if ang is not None:

@@ -182,13 +182,21 @@ def _envelope(r: np.ndarray, size: int, forward: bool) -> np.ndarray:
     return minimum_filter1d(r, size, mode="nearest", origin=origin)
 
 
+def _floor(x: np.ndarray) -> float:
+    """A low quantile (the tenth) of `x`: the least-delayed level, unmoved by one late sample."""
+    k = len(x) // 10
+    return float(np.partition(x, k)[k])
+
+
 def _find_gaps(t: np.ndarray, step: np.ndarray, period: float) -> list[Gap]:
     """Real gaps: long steps across which the lower envelope of the clock residual rises for good.
 
-    A first vectorised pass keeps the long steps whose envelope rises by half a period; those are
-    then confirmed in time order against the envelope with the gaps already found taken out, so
-    a burst's long step just after a real gap (or a second gap close behind one) is judged on its
-    own. A step must also be long enough to hold the samples it is said to have lost.
+    A vectorised pass keeps the long steps whose envelope rises by half a period. Each is then
+    confirmed by the least-delayed level (a low quantile, so that a few delayed samples at a
+    gap's edge do not count) just before and just after it, with the gaps already found taken
+    out: the longest steps first, then the shorter ones in time order, so that a burst's long
+    step right after a real gap is judged with that gap removed. A step must also be long
+    enough to hold the samples it lost.
     """
     candidates = np.flatnonzero(step > _CANDIDATE_STEP * period)
     if not len(candidates):
@@ -196,22 +204,19 @@ def _find_gaps(t: np.ndarray, step: np.ndarray, period: float) -> list[Gap]:
     r = t - t[0] - period * np.arange(len(t))  # clock residual; its envelope is the least-delayed samples
     size = min(_ENVELOPE, len(t))
     jump = _envelope(r, size, forward=True)[candidates + 1] - _envelope(r, size, forward=False)[candidates]
-    gaps: list[Gap] = []
-    index, total = [], []  # found gaps and the samples lost up to each
-    for i in candidates[jump >= 0.5 * period].tolist():
+    likely = candidates[jump >= 0.5 * period]
+    long_first = likely[step[likely] >= _LATE_STEP * period]
+    order = np.concatenate([long_first[np.argsort(-step[long_first], kind="stable")],
+                            likely[step[likely] < _LATE_STEP * period]])
+    lost_at = np.zeros(len(t))  # samples lost just before each sample, as found so far
+    for i in order.tolist():
         lo, hi = max(0, i - size + 1), min(len(t), i + 1 + size)
-        j = np.arange(lo, hi)
-        lost_before = np.zeros(hi - lo)
-        if index:
-            k = np.searchsorted(index, j, side="right")  # gaps at or before each sample
-            lost_before = np.where(k > 0, np.asarray(total)[np.maximum(k - 1, 0)], 0.0)
-        adj = r[lo:hi] - period * lost_before
-        lost = int(np.rint((adj[i + 1 - lo:].min() - adj[: i + 1 - lo].min()) / period))
+        adj = r[lo:hi] - period * np.cumsum(lost_at[lo:hi])  # levels relative within the window
+        lost = int(np.rint((_floor(adj[i + 1 - lo:]) - _floor(adj[: i + 1 - lo])) / period))
         if 1 <= lost <= int(np.rint(step[i] / period)):
-            gaps.append(Gap(i + 1, float(step[i]), lost))
-            index.append(i + 1)
-            total.append((total[-1] if total else 0) + lost)
-    return gaps
+            lost_at[i + 1] = lost
+    found = np.flatnonzero(lost_at)
+    return [Gap(int(j), float(step[j - 1]), int(lost_at[j])) for j in found]
 
 
 def analyse_time(t, *, has_time: bool = True) -> TimeBase:

@@ -14,6 +14,7 @@
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -22,7 +23,7 @@ from .observations import Observation, observe
 from .recording import Recording
 from .windows import Window
 
-__all__ = ["observe_window"]
+__all__ = ["observe_window", "pool_static_variance"]
 
 
 def observe_window(rec: Recording, w: Window, reference: str, speed: float | None, *,
@@ -61,3 +62,14 @@ def observe_window(rec: Recording, w: Window, reference: str, speed: float | Non
         return obs
     level, var = plateau_mean(samples, t)
     return dataclasses.replace(obs, mean=level if ripple else obs.mean, mean_var=var if long_run else None)
+
+
+def pool_static_variance(observations: Sequence[Observation]) -> tuple[Observation, ...]:
+    """Static windows' mean variances from one long-run variance per axis, pooled by sample count."""
+    statics = [o for o in observations if o.kind == "static" and o.mean_var is not None]
+    if len(statics) < 2:
+        return tuple(observations)
+    n = np.array([o.count for o in statics], dtype=float)
+    per_sample = np.sum([o.mean_var * o.count**2 for o in statics], axis=0) / n.sum()
+    return tuple(dataclasses.replace(o, mean_var=per_sample / o.count) if o.kind == "static" and o.mean_var is not None
+                 else o for o in observations)

@@ -49,8 +49,9 @@ class ServoProtocol:
         Plateau speed of every turn [rad/s] (seed 000: 60 deg/s).
     turns : tuple of str
         Turns in order, each ``+x``, ``-x``, ``+y``, ``-y``, ``+z`` or ``-z``; repeats allowed.
-    revolutions : float
-        Revolutions per turn; each turn turns exactly ``2 pi revolutions`` [rad].
+    revolutions : float or tuple of float
+        Revolutions per turn; each turn turns exactly ``2 pi revolutions`` [rad]. A tuple gives
+        one per turn (a robot's turns of 135 to 270 deg, a hand's uneven tilts).
     wait : float or tuple of float
         Static time between turns [s] (seed 000: 3 s); a tuple gives one per gap.
     lead_in, lead_out : float
@@ -82,7 +83,7 @@ class ServoProtocol:
 
     speed: float = math.radians(60.0)
     turns: tuple[str, ...] = PAPER_TURNS
-    revolutions: float = 1.0
+    revolutions: float | tuple[float, ...] = 1.0
     wait: float | tuple[float, ...] = 3.0
     lead_in: float = 2.0
     lead_out: float = 2.0
@@ -99,7 +100,12 @@ class ServoProtocol:
 
     def __post_init__(self):
         positive("speed", self.speed)
-        positive("revolutions", self.revolutions)
+        if not np.isscalar(self.revolutions):
+            object.__setattr__(self, "revolutions", tuple(float(r) for r in self.revolutions))
+        revs = np.atleast_1d(np.asarray(self.revolutions, dtype=float))
+        if revs.size not in (1, len(self.turns)) or not np.all(revs > 0) or not np.all(np.isfinite(revs)):
+            raise InputError(f"revolutions must be one number > 0 or one per turn ({len(self.turns)}), "
+                             f"got {self.revolutions!r}")
         if not self.turns:
             raise InputError("turns is empty; give at least one of +x, -x, +y, -y, +z, -z")
         object.__setattr__(self, "turns", tuple(self.turns))
@@ -152,8 +158,13 @@ class ServoProtocol:
 
     @property
     def turn_angle(self) -> float:
-        """Angle of every turn [rad]."""
-        return 2.0 * math.pi * self.revolutions
+        """Angle of every turn [rad] (of the first, when they differ)."""
+        return float(self.turn_angles()[0])
+
+    def turn_angles(self) -> np.ndarray:
+        """Angle of each turn [rad]."""
+        revs = np.atleast_1d(np.asarray(self.revolutions, dtype=float))
+        return 2.0 * math.pi * np.broadcast_to(revs, (len(self.turns),))
 
 
 @dataclass(frozen=True)
@@ -290,11 +301,11 @@ def simulate_servo(
     static(p.lead_in)
     waits = p.waits()
     pieces = int(p.pauses) + 1
-    for i, (turn, (axis, sign)) in enumerate(zip(p.turns, p._parsed)):
+    for i, (turn, (axis, sign), total) in enumerate(zip(p.turns, p._parsed, p.turn_angles().tolist())):
         start = pos
         parts = []
         for j in range(pieces):
-            rates, lo, hi = _piece(p, p.turn_angle / pieces, fs, rng)
+            rates, lo, hi = _piece(p, total / pieces, fs, rng)
             if pieces == 1 and p.unevenness == 0 and hi - lo >= 2:
                 plateaus.append(Window(pos + lo, pos + hi, "rotation", "xyz"[axis], sign, p.speed * (hi - lo) / fs,
                                        p.speed, label=turn))
@@ -306,8 +317,8 @@ def simulate_servo(
                 pos += n_pause
         scalar = np.concatenate(parts)
         chunks.append(np.outer(sign * scalar, mounting[:, axis]))
-        windows.append(Window(start, pos, "rotation", "xyz"[axis], sign, p.turn_angle,
-                              p.turn_angle * fs / (pos - start), label=turn))
+        windows.append(Window(start, pos, "rotation", "xyz"[axis], sign, total, total * fs / (pos - start),
+                              label=turn))
         if i < len(waits):
             static(waits[i])
     static(p.lead_out)

@@ -87,14 +87,16 @@ def receive_times(n: int, sample_rate: float, clock: ReceiveClock, rng: np.rando
 
 
 def drop_samples(n: int, gaps: int, lost: int, rng: np.random.Generator, *, margin: int = 0) -> np.ndarray:
-    """Boolean mask (n,) that keeps every sample but `gaps` runs of `lost` samples at random places."""
+    """Boolean mask (n,) that keeps every sample but `gaps` runs of `lost` samples at random places,
+    at least `margin` samples from either end and from each other."""
     keep = np.ones(n, dtype=bool)
     if gaps <= 0 or lost <= 0:
         return keep
+    spacing = lost + max(margin, 1)
     lo, hi = margin, n - margin - lost
-    if hi - lo < gaps * (lost + 1):
+    if hi - lo < gaps * spacing:
         raise InputError(f"{gaps} gaps of {lost} samples do not fit in {n} samples")
-    starts = np.sort(rng.choice(np.arange(lo, hi, lost + 1), size=gaps, replace=False))
+    starts = np.sort(rng.choice(np.arange(lo, hi, spacing), size=gaps, replace=False))
     for s in starts:
         keep[s:s + lost] = False
     return keep
