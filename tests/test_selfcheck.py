@@ -17,7 +17,7 @@ import pytest
 from gyrocal.errors import InputError, SegmentationError
 from gyrocal.models import ScaleBias
 from gyrocal.pipeline import calibrate
-from gyrocal.quality import FitQuality
+from gyrocal.quality import GoodnessOfFit
 from gyrocal.recording import Recording
 from gyrocal.segmentation import segment
 from gyrocal.simulation import VirtualGyro
@@ -220,5 +220,5 @@ def test_fit_quality_round_trips_through_its_document(rng):
     q = calibrate(rec, angle=2 * math.pi).quality
     doc = q.to_document()
     assert set(doc) >= {"chi2", "dof", "p_value", "birge_ratio", "covariance_scaled", "residuals", "warnings"}
-    assert FitQuality.from_document(doc) == q
+    assert GoodnessOfFit.from_document(doc) == q
     assert len(doc["residuals"]) == len(q.labels) and len(doc["residuals"][0]["z"]) == 3  # a static window first

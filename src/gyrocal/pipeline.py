@@ -27,11 +27,10 @@ from .errors import InputError
 from .estimators import FitResult, make_estimator, window_residuals
 from .observations import Observation, ObservationSet
 from .plausibility import Context, check_plausibility
-from .quality import FitQuality, assess_fit
+from .quality import GoodnessOfFit, assess_fit
 from .recording import Recording
 from .screening import require_constant_rate, screen_gaps
-from .segmentation import Segmentation, segment
-from .segmentation._motion import static_level
+from .segmentation import Segmentation, segment, standstill_level
 from .timebase import TimeBase
 from .units import parse_input_unit, parse_rate_unit, unit_factor
 from .window_stats import observe_window, pool_static_variance
@@ -57,7 +56,7 @@ class CalibrationRun:
     reference : {"speed", "angle"}
     reference_value : float
         The known speed [rad/s] or angle per turn [rad].
-    quality : FitQuality or None
+    quality : GoodnessOfFit or None
         Goodness of fit (residuals per window in noise units, chi2/dof, p-value, Birge scaling);
         None when the self-checks were off.
     time_base : TimeBase or None
@@ -75,7 +74,7 @@ class CalibrationRun:
     observations: tuple[Observation, ...]
     reference: str
     reference_value: float
-    quality: FitQuality | None = None
+    quality: GoodnessOfFit | None = None
     time_base: TimeBase | None = None
     warnings: tuple[str, ...] = ()
     notes: tuple[str, ...] = ()
@@ -132,10 +131,7 @@ class CalibrationRun:
 
 
 def _baseline(rec: Recording, windows: Sequence[Window]) -> np.ndarray:
-    statics = [w for w in windows if w.kind == "static"]
-    if statics:
-        return np.mean(np.concatenate([rec.gyro[w.start:w.stop] for w in statics]), axis=0)
-    return static_level(rec.gyro, max(8, int(round(0.25 * rec.sample_rate))))[0]
+    return standstill_level(rec, windows)
 
 
 #: A given window's first or last tenth may turn this much slower than its middle (--speed only).
@@ -295,8 +291,22 @@ def calibrate(
         covariance=fit.covariance,
         noise_std=fit.noise_std,
         windows=tuple({**w.to_dict(), "rate": o.rate} for w, o in zip(used, observations)),
+        fit=None if quality is None else quality.to_document(),
     )
+    if tb is not None:
+        cal = dataclasses.replace(cal, observed=_observed(rec, tb, fit.noise_std, cal.input_scale, input_units))
     return CalibrationRun(cal, fit, seg, observations, reference, value, quality, tb, tuple(warnings), tuple(notes))
+
+
+def _observed(rec: Recording, tb: TimeBase, noise_std, input_scale: float, input_units: str) -> dict:
+    """What the calibration saw (the file's ``observed`` section), rates in the input units.
+
+    `input_scale` is internal units per input unit (:attr:`gyrocal.calibration.Calibration.input_scale`).
+    """
+    peak = np.maximum(rec.gyro.max(axis=0), -rec.gyro.min(axis=0))
+    return {"sample_rate": rec.sample_rate, "units": input_units,
+            "noise_std": (np.asarray(noise_std, dtype=float) / input_scale).tolist(),
+            "max_abs_rate": (peak / input_scale).tolist(), "time_base": tb.to_document()}
 
 
 def _label(w: Window) -> str:

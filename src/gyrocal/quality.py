@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["P_THRESHOLD", "FitQuality", "assess_fit"]
+__all__ = ["P_THRESHOLD", "GoodnessOfFit", "assess_fit"]
 
 #: Below this p-value the windows disagree beyond their noise and the covariance is scaled.
 P_THRESHOLD = 1e-3
@@ -25,7 +25,7 @@ _NAMED = 3  # windows named in a warning
 
 
 @dataclass(frozen=True)
-class FitQuality:
+class GoodnessOfFit:
     """How well the windows agree with the fitted model.
 
     Attributes
@@ -91,7 +91,7 @@ class FitQuality:
         }
 
     @classmethod
-    def from_document(cls, doc: dict) -> FitQuality:
+    def from_document(cls, doc: dict) -> GoodnessOfFit:
         """Inverse of :meth:`to_document`."""
         res = doc.get("residuals") or []
         return cls(
@@ -112,7 +112,7 @@ def _name(i: int, label: str, z: Sequence[float]) -> str:
 
 
 def assess_fit(residuals: Sequence[Sequence[float]], labels: Sequence[str], n_params: int, *,
-               what: str = "the windows") -> FitQuality:
+               what: str = "the windows") -> GoodnessOfFit:
     """Goodness of fit from per-window residuals in noise units.
 
     Parameters
@@ -137,14 +137,14 @@ def assess_fit(residuals: Sequence[Sequence[float]], labels: Sequence[str], n_pa
     if dof <= 0:
         note = (f"no residual degrees of freedom: {rows} equations for {n_params} parameters, so nothing checks "
                 f"{what} against each other; add static windows or repeat turns to let the fit check itself")
-        return FitQuality(chi2, 0, None, None, False, tuple(labels), zs, (), (note,))
+        return GoodnessOfFit(chi2, 0, None, None, False, tuple(labels), zs, (), (note,))
     p = float(chi2_dist.sf(chi2, dof))
     birge = math.sqrt(chi2 / dof)
     if p >= P_THRESHOLD:
-        return FitQuality(chi2, dof, p, birge, False, tuple(labels), zs)
+        return GoodnessOfFit(chi2, dof, p, birge, False, tuple(labels), zs)
     worst = tuple(int(i) for i in np.argsort(-per_window)[:_NAMED])
     names = ", ".join(_name(i, labels[i], z[i]) for i in worst)
     warning = (f"{what} disagree beyond their noise: chi2/dof = {chi2 / dof:.3g} ({dof} dof, p = {p:.2g}); "
                f"most: {names}; every 1-sigma is scaled by the Birge ratio {birge:.3g}. Check these windows "
                "(declared angle or speed, a slipping mount, a drifting bias)")
-    return FitQuality(chi2, dof, p, birge, True, tuple(labels), zs, worst, (warning,))
+    return GoodnessOfFit(chi2, dof, p, birge, True, tuple(labels), zs, worst, (warning,))

@@ -151,19 +151,26 @@ class TimeBase:
         """Gaps between samples ``start`` and ``stop - 1`` (inside a window ``start:stop``)."""
         return tuple(g for g in self.gaps if start < g.index < stop)
 
+    def to_document(self) -> dict:
+        """JSON-ready facts (the calibration file's ``observed.time_base``), times in seconds."""
+        return {"nominal_rate": self.sample_rate, "has_time": self.has_time, "mean_step": self.mean_step,
+                "median_step": self.median_step, "jitter": self.jitter, "late_deliveries": self.delayed,
+                "gaps": len(self.gaps), "lost_samples": self.lost, "regular_clock": self.regular_clock}
+
     def describe(self) -> list[str]:
         """Plain lines for people: rate, steps, jitter, delayed deliveries and gaps."""
         ms = 1e3
         if not self.has_time:
             return [f"time base: no time column; {self.sample_rate:.6g} Hz as declared, {self.n} samples"]
+        jitter = f"{self.jitter * ms:.3g} ms" if self.jitter > 1e-6 * self.period else "none"
         lines = [
             f"time base: {self.sample_rate:.6g} Hz nominal (mean step of the sensor clock); "
-            f"steps mean {self.mean_step * ms:.4g} ms, median {self.median_step * ms:.4g} ms, "
-            f"jitter {self.jitter * ms:.3g} ms"
+            f"steps mean {self.mean_step * ms:.4g} ms, median {self.median_step * ms:.4g} ms, jitter {jitter}"
         ]
         if self.bursty:
-            lines.append("  steps are bursty (receive-time stamps?): angles are integrated on the stamps and the "
-                         "rate is the mean one, never the median step")
+            on = ("the sensor's regular clock rebuilt from them" if self.regular_clock else "the stamps")
+            lines.append(f"  steps are bursty (receive-time stamps?): angles are integrated on {on}, and the rate "
+                         "is the mean one, never the median step")
         if self.delayed:
             lines.append(f"  {self.delayed} late deliveries (a long step caught up by a burst; no sample lost)")
         if self.gaps:
