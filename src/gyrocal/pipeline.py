@@ -243,8 +243,9 @@ def calibrate(
     if noise_std is not None and method != "first-moment":
         raise InputError(f"noise_std applies to method 'first-moment' only, got method={method!r}")
     if noise_std is not None and not np.all(np.asarray(noise_std, dtype=float) > 0):
-        raise InputError(f"noise_std must be > 0 on every axis, got {noise_std!r}: a zero noise would give a zero "
-                         "1-sigma; measure it (gyrocal noise) or leave it out to estimate it from the windows")
+        raise InputError(f"{{param}} must be > 0 on every axis, got {noise_std!r}: a zero noise would give a zero "
+                         "1-sigma", param="noise_std", value=noise_std,
+                         hint="measure it (gyrocal noise) or leave {param} out to estimate it from the windows")
     estimator = make_estimator(method, **({} if noise_std is None else {"noise_std": noise_std}))
     input_units = parse_input_unit(rec.source_units, "recording source_units")
     out_units = parse_rate_unit(output_units or ("deg/s" if input_units == "counts" else input_units), "output_units")

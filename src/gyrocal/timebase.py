@@ -117,8 +117,8 @@ class TimeBase:
 
     @property
     def sample_rate(self) -> float:
-        """Nominal rate [Hz]."""
-        return 1.0 / self.period
+        """Nominal rate [Hz]: of the regular sensor clock when there is one, else of the block-mean steps."""
+        return 1.0 / (self.clock_period if self.regular_clock else self.period)
 
     @property
     def lost(self) -> int:

@@ -99,15 +99,12 @@ def speed_turns(view, mo: Motion, speed: float, plateau_tol: float, min_plateau:
     unit = 180 / math.pi if view.units == "rad/s" else 1.0
     uname = "deg/s" if view.units == "rad/s" else "counts"
     steady = (cv <= plateau_tol) & (off <= MAX_OFF_AXIS_DEG)
-    idx = np.flatnonzero(steady)
-    keep_sub, why_sub = select_by_axis(mean[idx], ax[idx], ref, k_range=k_range, agree_tol=agree_tol,
-                                       describe=lambda r: f"{r * unit:.3g} {uname}")
-    why = dict(zip(idx.tolist(), why_sub))
-    keep = dict(zip(idx.tolist(), keep_sub.tolist()))
+    keep, why = select_by_axis(mean, ax, ref, eligible=steady, k_range=k_range, agree_tol=agree_tol,
+                               describe=lambda r: f"{r * unit:.3g} {uname}")
     chosen, ignored = [], []
     for i in range(len(p0)):
         label = f"{'+' if sg[i] > 0 else '-'}{'xyz'[ax[i]]}"
-        if keep.get(i, False):
+        if keep[i]:
             n = int(p1[i] - p0[i])
             chosen.append(Window(int(p0[i]), int(p1[i]), "rotation", "xyz"[ax[i]], int(sg[i]), speed * n / fs, speed,
                                  label))

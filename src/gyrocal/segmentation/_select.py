@@ -33,6 +33,7 @@ def select_by_axis(
     axis: np.ndarray,
     declared: float,
     *,
+    eligible: np.ndarray | None = None,
     k_range: tuple[float, float] = K_RANGE,
     agree_tol: float = AGREE_TOL,
     describe,
@@ -47,6 +48,9 @@ def select_by_axis(
         Dominant body axis (0, 1, 2) of each candidate.
     declared : float
         The declared size.
+    eligible : ndarray of bool, shape (R,), optional
+        Candidates with the structure of a turn; the others are neither kept nor judged
+        (their reason is None: the caller gives it).
     k_range : (float, float)
         Scale factors a candidate may imply (``declared / size``).
     agree_tol : float
@@ -62,8 +66,9 @@ def select_by_axis(
     """
     size = np.asarray(size, dtype=float)
     axis = np.asarray(axis)
+    ok = np.ones(len(size), dtype=bool) if eligible is None else np.asarray(eligible, dtype=bool)
     lo, hi = declared / k_range[1], declared / k_range[0]
-    in_range = (size >= lo) & (size <= hi)
+    in_range = (size >= lo) & (size <= hi) & ok
     keep = np.zeros(len(size), dtype=bool)
     reasons: list[str | None] = [None] * len(size)
     tol = math.log1p(agree_tol)
@@ -79,7 +84,7 @@ def select_by_axis(
         for i in mine[~agree]:
             reasons[i] = (f"{describe(size[i])} where the other {'xyz'[j]} turns make {describe(math.exp(centre))} "
                           f"(declared {describe(declared)}): one scale factor cannot explain both")
-    for i in np.flatnonzero(~in_range):
+    for i in np.flatnonzero(~in_range & ok):
         k = declared / size[i]
         reasons[i] = (f"{describe(size[i])}, declared {describe(declared)}: that is a scale factor of {k:.3g}, "
                       f"outside {k_range[0]:g}-{k_range[1]:g}")

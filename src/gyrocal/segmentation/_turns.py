@@ -127,17 +127,12 @@ def angle_turns(view, mo: Motion, angle: float, max_pause: float, pad: float, *,
                             len(view), round(pad * fs))
     brief = turned < 0.05 * angle
     clean = ~brief & (off <= MAX_OFF_AXIS_DEG) & (purity >= _MIN_PURITY)
-    keep, why = np.zeros(len(groups), dtype=bool), [None] * len(groups)
-    idx = np.flatnonzero(clean)
-    sub_keep, sub_why = select_by_axis(turned[idx], ax[idx], angle, k_range=k_range, agree_tol=agree_tol,
-                                       describe=lambda a: f"{math.degrees(a):.0f} deg")
-    keep[idx] = sub_keep
-    for i, r in zip(idx, sub_why):
-        why[i] = r
+    keep, why = select_by_axis(turned, ax, angle, eligible=clean, k_range=k_range, agree_tol=agree_tol,
+                               describe=lambda a: f"{math.degrees(a):.0f} deg")
     chosen, ignored = [], []
     for i, (start, stop) in enumerate(zip(starts.tolist(), stops.tolist())):
         label = f"{'+' if sg[i] > 0 else '-'}{'xyz'[ax[i]]}"
-        if clean[i] and keep[i]:
+        if keep[i]:
             chosen.append(Window(start, stop, "rotation", "xyz"[ax[i]], int(sg[i]), angle,
                                  angle * fs / (stop - start), label))
             continue
