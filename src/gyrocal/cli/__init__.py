@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 
 from .app import app, run
-from . import calibrate_cmds, sim_cmds, thermal_cmds  # noqa: F401  (register commands)
+from . import calibrate_cmds, capture_cmds, sim_cmds, thermal_cmds  # noqa: F401  (register commands)
 
 __all__ = ["app", "main"]
 
