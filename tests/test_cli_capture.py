@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from cli_runner import invoke, refused
+from cli_runner import refused
 
 from gyrocal.capture import frames as fr
 from gyrocal.capture.device import Faults, VirtualDevice, device_bytes
@@ -176,9 +176,7 @@ def test_refusals_are_one_line(tmp_path):
 
 def test_nothing_received_is_an_error_and_writes_nothing(tmp_path):
     with VirtualDevice(b"") as dev:
-        port = dev.start()
-        dev.release()
-        code, _out, err = invoke("capture", "--port", port, "-o", tmp_path / "r.csv")
+        code, _out, err = start(dev, "-o", tmp_path / "r.csv").finish()
     assert code == 2 and "no samples received" in err
     assert not (tmp_path / "r.csv").exists() and not list(tmp_path.glob(".*"))
 

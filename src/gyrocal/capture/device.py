@@ -254,7 +254,7 @@ class VirtualDevice:
         buf = fcntl.ioctl(self._slave, termios.FIONREAD, struct.pack("i", 0))
         return struct.unpack("i", buf)[0]
 
-    def _drain(self, quiet: float = 0.25) -> None:
+    def _drain(self, quiet: float = 0.5) -> None:
         """Wait until the reader has taken every byte sent: closing a pty discards unread input.
 
         The kernel hands written bytes to the reader's queue a little later (a work queue), so the
