@@ -314,7 +314,8 @@ def test_example_uncertainty_matches_monte_carlo_within_20_percent(tmp_path):
 def thermal_file(tmp_path):
     """A thermal table whose bias grows 0.01 deg/s per degC, with a 1 % x scale error."""
     from gyrocal.models import Affine
-    from gyrocal.thermal import ThermalCalibration, fit_smooth, save_thermal
+    from gyrocal.files import save_thermal
+    from gyrocal.thermal import ThermalCalibration, fit_smooth
 
     temps = np.array([-10.0, 10.0, 30.0, 50.0])
     K = np.diag([1.01, 1.0, 1.0])

@@ -17,7 +17,7 @@ import pytest
 imucal = pytest.importorskip("imucal")
 pd = pytest.importorskip("pandas")
 
-from gyrocal.calibration import load_calibration
+from gyrocal.files import load_calibration
 from gyrocal.cli.app import run
 
 DATA = Path(str(resources.files("gyrocal") / "data" / "imucal_ferraris"))

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from gyrocal.calibration import load_calibration, save_calibration
+from gyrocal.files import load_calibration, save_calibration
 from gyrocal.errors import InputError, SegmentationError
 from gyrocal.models import ScaleBias
 from gyrocal.pipeline import CalibrationRun, calibrate

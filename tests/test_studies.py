@@ -114,7 +114,7 @@ def test_run_study_rejects_bad_arguments(tmp_path):
 
 
 def test_study_plots_draw_their_artists():
-    from gyrocal.plotting._mpl import new_figure
+    from gyrocal.plotting import new_figure
     from gyrocal.plotting.studies import convergence, error_boxes, mse_vs_speed, rms_by_temperature
 
     fig = new_figure()

@@ -77,7 +77,7 @@ def test_markdown_table():
 
 
 def test_figures_draw_the_expected_artists(calibrated):
-    from gyrocal.plotting._mpl import new_figure
+    from gyrocal.plotting import new_figure
     from gyrocal.plotting.thermal import plot_coefficients, plot_error_vs_rate, plot_error_vs_temperature
 
     truth, cal, ev = calibrated

@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ._arrays import readonly
 from ._validation import finite_array, positive
 from .errors import InputError
 from .estimators._checks import require_count, require_full_rank
@@ -91,9 +92,7 @@ class Rotation:
         norm = float(np.linalg.norm(a))
         if norm == 0:
             raise InputError("axis must be a non-zero vector, got [0, 0, 0]")
-        a = a / norm
-        a.setflags(write=False)
-        object.__setattr__(self, "axis", a)
+        object.__setattr__(self, "axis", readonly(a / norm, copy=False))
         object.__setattr__(self, "speed", positive("speed", self.speed))
         object.__setattr__(self, "angle", positive("angle", self.angle))
 

@@ -22,10 +22,11 @@ from typing import ClassVar
 
 import numpy as np
 
+from ._arrays import readonly
 from ._validation import finite_array, vector3
 from .errors import InputError, NonPhysicalEstimateError
 
-__all__ = ["KG_INDEX", "KG_NAMES", "Affine", "CalibrationModel", "ScaleBias", "correct"]
+__all__ = ["KG_INDEX", "KG_NAMES", "Affine", "CalibrationModel", "ScaleBias", "correct", "kb_to_kg", "kg_to_kb"]
 
 #: Seed 001 eq. 14: element order of the 12-vector Kg.
 KG_NAMES: tuple[str, ...] = ("Kxx", "Kyy", "Kzz", "Kyx", "Kzx", "Kxy", "Kzy", "Kxz", "Kyz", "Bx", "By", "Bz")
@@ -36,16 +37,27 @@ _KG_ROWS = np.array([r for r, _ in KG_INDEX])
 _KG_COLS = np.array([c for _, c in KG_INDEX])
 
 
+def kg_to_kb(kg) -> tuple[np.ndarray, np.ndarray]:
+    """``K`` (..., 3, 3) and ``B`` (..., 3) from Kg vectors (..., 12): the one Kg -> K mapping (eq. 11, 14).
+
+    The C library's ``gyrocal_thermal_correct`` unpacks Kg the same way; a test ties the two.
+    """
+    kg = np.asarray(kg, dtype=float)
+    K = np.zeros(kg.shape[:-1] + (3, 3))
+    K[..., _KG_ROWS, _KG_COLS] = kg[..., :9]
+    return K, kg[..., 9:].copy()
+
+
+def kb_to_kg(K, B) -> np.ndarray:
+    """Kg vectors (..., 12) from ``K`` (..., 3, 3) and ``B`` (..., 3): the inverse of :func:`kg_to_kb`."""
+    K = np.asarray(K, dtype=float)
+    return np.concatenate([K[..., _KG_ROWS, _KG_COLS], np.asarray(B, dtype=float)], axis=-1)
+
+
 def correct(matrix: np.ndarray, offset: np.ndarray, readings) -> np.ndarray:
     """Apply ``w_true = matrix @ (m - offset)`` to readings of shape (..., 3) [reading units]."""
     m = finite_array("readings", readings, shape_tail=(3,))
     return (m - offset) @ np.asarray(matrix).T
-
-
-def _freeze(arr: np.ndarray) -> np.ndarray:
-    arr = np.array(arr, dtype=float)
-    arr.setflags(write=False)
-    return arr
 
 
 @dataclass(frozen=True)
@@ -70,8 +82,8 @@ class ScaleBias:
         k = vector3("k", self.k)
         if np.any(k <= 0):
             raise NonPhysicalEstimateError(f"scale factors k must be > 0, got {k.tolist()}")
-        object.__setattr__(self, "k", _freeze(k))
-        object.__setattr__(self, "b", _freeze(vector3("b", self.b)))
+        object.__setattr__(self, "k", readonly(k, copy=True))
+        object.__setattr__(self, "b", readonly(vector3("b", self.b), copy=True))
 
     @property
     def matrix(self) -> np.ndarray:
@@ -115,7 +127,7 @@ class ScaleBias:
         return Affine.from_canonical(self.matrix, self.offset)
 
     def to_dict(self) -> dict:
-        """Seed 000 parameters, as plain lists."""
+        """The servo method's parameters (Wang et al., eq. 1), as plain lists."""
         return {"k": self.k.tolist(), "b": self.b.tolist()}
 
 
@@ -142,8 +154,8 @@ class Affine:
         cond = np.linalg.cond(K)
         if not np.isfinite(cond) or cond > 1e12:
             raise NonPhysicalEstimateError(f"K is singular (condition number {cond:.3g}); it cannot be inverted")
-        object.__setattr__(self, "K", _freeze(K))
-        object.__setattr__(self, "B", _freeze(vector3("B", self.B)))
+        object.__setattr__(self, "K", readonly(K, copy=True))
+        object.__setattr__(self, "B", readonly(vector3("B", self.B), copy=True))
 
     @property
     def matrix(self) -> np.ndarray:
@@ -158,7 +170,7 @@ class Affine:
     @property
     def kg(self) -> np.ndarray:
         """Seed 001 eq. 14 12-vector ``[Kxx, Kyy, Kzz, Kyx, Kzx, Kxy, Kzy, Kxz, Kyz, Bx, By, Bz]``."""
-        return np.concatenate([self.K[_KG_ROWS, _KG_COLS], self.B])
+        return kb_to_kg(self.K, self.B)
 
     @property
     def params(self) -> np.ndarray:
@@ -168,10 +180,7 @@ class Affine:
     @classmethod
     def from_kg(cls, kg) -> Affine:
         """Build from the seed 001 12-vector (eq. 14 order)."""
-        v = finite_array("kg", kg, shape_tail=(12,), ndim=1)
-        K = np.zeros((3, 3))
-        K[_KG_ROWS, _KG_COLS] = v[:9]
-        return cls(K=K, B=v[9:])
+        return cls(*kg_to_kb(finite_array("kg", kg, shape_tail=(12,), ndim=1)))
 
     from_params = from_kg
 
@@ -196,8 +205,8 @@ class Affine:
         return self
 
     def to_dict(self) -> dict:
-        """Seed 001 parameters: Kg in eq. 14 order, with names."""
-        return {"kg": self.kg.tolist(), "kg_names": list(KG_NAMES)}
+        """The full-temperature-range method's parameters: K, B, and Kg in eq. 14 order with that order."""
+        return {"K": self.K.tolist(), "B": self.B.tolist(), "kg": self.kg.tolist(), "kg_order": list(KG_NAMES)}
 
 
 CalibrationModel = ScaleBias | Affine

@@ -20,6 +20,7 @@ from typing import Literal
 
 import numpy as np
 
+from ._arrays import readonly
 from ._validation import finite_array, positive
 from .errors import InputError
 
@@ -66,8 +67,7 @@ class Observation:
     def __post_init__(self):
         for name in ("mean", "mean_sq", "noise_var"):
             arr = finite_array(name, getattr(self, name), shape_tail=(3,), ndim=1)
-            arr.setflags(write=False)
-            object.__setattr__(self, name, arr)
+            object.__setattr__(self, name, readonly(arr, copy=True))
         if self.kind not in _KINDS:
             raise InputError(f"kind={self.kind!r} is not one of {_KINDS}")
         if int(self.count) < 2:

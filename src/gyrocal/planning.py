@@ -9,18 +9,18 @@ deviations of the scale factors and biases.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal, Sequence, get_args
+from typing import Sequence, get_args
 
 import numpy as np
 
 from ._validation import positive
+from .choices import DesignName
 from .design import Design, predicted_std
 from .errors import InputError
 from .models import ScaleBias
 
 __all__ = ["DesignName", "DESIGN_NAMES", "Plan", "build_design", "predict", "suggest"]
 
-DesignName = Literal["six", "six-static", "twelve"]
 DESIGN_NAMES: tuple[str, ...] = get_args(DesignName)
 
 

@@ -20,6 +20,11 @@
 
 #include <stdint.h>
 
+/* Version of this library's interface and table layout. Headers exported by gyrocal
+ * (gyrocal export --format c-header) check it, so a table never meets a library it was
+ * not made for; gyrocal.firmware.header.C_LIBRARY_VERSION holds the same number. */
+#define GYROCAL_CAL_VERSION 2
+
 #ifdef __cplusplus
 extern "C" {
 #endif

@@ -79,7 +79,7 @@ def _headerless(path: Path, lines: list[str], layout: Layout) -> InputError:
     )
 
 
-def _mapped(path: Path, lines: list[str], layout: Layout, columns) -> tuple[Layout, dict[str, str]]:
+def _mapped(path: Path, lines: list[str], layout: Layout, columns, accel: bool = False) -> tuple[Layout, dict[str, str]]:
     """The layout whose names hold the gyro columns (the first reading, else another one, e.g. the
     header over a units row) and the mapping of canonical names to its columns."""
     names = layout.names
@@ -92,14 +92,15 @@ def _mapped(path: Path, lines: list[str], layout: Layout, columns) -> tuple[Layo
     for reading in (layout, *layout.others):
         where = "no header row; columns count from 1" if reading.header is None else f"header on line {reading.header + 1}"
         try:
-            return reading, resolve(reading.names, columns, path.name, where=where, header=reading.header is not None)
+            return reading, resolve(reading.names, columns, path.name, where=where, header=reading.header is not None,
+                                    accel=accel)
         except InputError as exc:
             error = error or exc
     raise error
 
 
 def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool | None = None,
-                     skip_rows: int | None = None):
+                     skip_rows: int | None = None, accel: bool = False):
     """Read a text table, plain or compressed.
 
     Parameters
@@ -113,6 +114,8 @@ def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool
     skip_rows : int, optional
         Lines above the header (or the first data row) to skip; default: metadata lines are
         found and skipped (see :func:`gyrocal.io._layout.find_layout`).
+    accel : bool
+        Look for the accelerometer columns ``ax, ay, az`` too.
 
     Returns
     -------
@@ -127,7 +130,7 @@ def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool
     layout = find_layout(lines, path.name, skip_rows)
     if layout.header is None and not columns:
         raise _headerless(path, lines, layout)
-    layout, mapping = _mapped(path, lines, layout, columns)
+    layout, mapping = _mapped(path, lines, layout, columns, accel)
     names = layout.names
     if use_pyarrow is None:
         try:

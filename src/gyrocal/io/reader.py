@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..errors import InputError
 from ..recording import Recording
-from ._build import SaturationPolicy, build_recording
+from ._build import STANDARD_GRAVITY, SaturationPolicy, build_recording
 from ._source import compression
 
 __all__ = ["read_recording", "TEXT_SUFFIXES", "BAG_SUFFIXES"]
@@ -50,6 +50,10 @@ def read_recording(
     saturation: SaturationPolicy = "error",
     full_scale: float | None = None,
     skip_rows: int | None = None,
+    accel_units: str | None = None,
+    accel_sensitivity: float | None = None,
+    gravity: float = STANDARD_GRAVITY,
+    need_accel: bool = False,
 ) -> Recording:
     """Read a gyro recording from a file and check it.
 
@@ -92,6 +96,16 @@ def read_recording(
         Text tables: lines to skip above the header row (or above the first data row of a
         table without a header). Default: metadata lines such as ``Fs,100`` are recognised
         (fewer fields than the table, or not followed by data) and skipped.
+    accel_units : {"m/s^2", "g", "counts"}, optional
+        Unit of the accelerometer columns ``ax, ay, az`` (found by name or alias: ``acc_x``,
+        ``accel_x``, ``ax``, ..., or mapped with `columns`). Without it they are not read
+        (they pass through as other columns), unless mapped in `columns`, which is refused.
+    accel_sensitivity : float, optional
+        For ``accel_units="counts"``: LSB per g. Without it accelerometer counts stay counts.
+    gravity : float
+        One g [m/s^2], for ``g`` and for counts with a sensitivity (default 9.80665).
+    need_accel : bool
+        Refuse a call without `accel_units` (for commands that need the accelerometer).
 
     Returns
     -------
@@ -106,6 +120,10 @@ def read_recording(
     path = Path(path)
     if not path.exists():
         raise InputError(f"recording {str(path)!r} does not exist")
+    if need_accel and accel_units is None:
+        raise InputError(f"{path.name}: the accelerometer's unit is not given", param="accel_units",
+                         hint="give {param} m/s^2, g or counts (with the accelerometer sensitivity for counts)")
+    accel = accel_units is not None
     kind = _kind(path)
     if skip_rows is not None:
         if kind != "text":
@@ -117,15 +135,15 @@ def read_recording(
 
         if columns:
             raise InputError("columns= does not apply to ROS bags (angular_velocity and header stamps are used)")
-        data, extra = read_bag_columns(path, topic)
+        data, extra = read_bag_columns(path, topic, accel=accel)
     elif kind == "parquet":
         from .parquet import read_parquet_columns
 
-        data, extra = read_parquet_columns(path, columns)
+        data, extra = read_parquet_columns(path, columns, accel=accel)
     else:
         from .csvfile import read_csv_columns
 
-        data, extra = read_csv_columns(path, columns, skip_rows=skip_rows)
+        data, extra = read_csv_columns(path, columns, skip_rows=skip_rows, accel=accel)
     return build_recording(
         data,
         extra,
@@ -137,4 +155,7 @@ def read_recording(
         check_units=check_units,
         saturation=saturation,
         full_scale=full_scale,
+        accel_units=accel_units,
+        accel_sensitivity=accel_sensitivity,
+        gravity=gravity,
     )

@@ -10,7 +10,7 @@ from typing import Mapping
 
 import numpy as np
 
-from ._mpl import new_figure
+from .figure import new_figure
 
 __all__ = ["error_boxes", "error_box_figure", "mse_vs_speed", "mse_speed_figure", "convergence", "convergence_figure",
            "rms_by_temperature", "rms_by_temperature_figure"]

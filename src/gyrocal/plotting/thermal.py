@@ -16,7 +16,7 @@ import numpy as np
 
 from ..models import KG_NAMES
 from ..units import unit_factor
-from ._mpl import new_figure
+from .figure import new_figure
 
 __all__ = ["METHOD_STYLE", "plot_coefficients", "plot_error_vs_rate", "plot_error_vs_temperature"]
 

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._arrays import readonly
 from .._validation import positive
 from ..errors import InputError
 from ..models import CalibrationModel
@@ -287,6 +288,5 @@ def simulate_servo(
     true = np.concatenate(chunks)
     rec = Recording(t=np.arange(len(true)) / fs, gyro=gyro.measure(true, fs, rng), units="rad/s",
                     source_units="rad/s", sample_rate=fs)
-    true.setflags(write=False)
-    mounting.setflags(write=False)
-    return rec, ServoTruth(true, tuple(windows), tuple(plateaus), gyro.model, mounting)
+    return rec, ServoTruth(readonly(true, copy=False), tuple(windows), tuple(plateaus), gyro.model,
+                           readonly(mounting, copy=False))

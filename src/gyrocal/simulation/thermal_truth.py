@@ -81,6 +81,12 @@ class ThermalTruth:
 
     def __call__(self, temp) -> tuple[np.ndarray, np.ndarray]:
         """``(K (N, 3, 3), B (N, 3) [rad/s])`` at temperatures (N,) [degC], for ``VirtualGyro(thermal=...)``."""
-        from ..thermal.model import kg_to_kb
+        from ..models import kg_to_kb
 
         return kg_to_kb(self.kg(temp))
+
+    def to_dict(self) -> dict:
+        """The truth's settings as plain JSON values (for a truth document)."""
+        return {"ref_temp": self.ref_temp, "kg_ref": [float(v) for v in self.kg_ref],
+                "scale_slope": [float(v) for v in self.scale_slope],
+                "bias_poly_deg_s": [[float(v) for v in row] for row in self.bias_poly]}

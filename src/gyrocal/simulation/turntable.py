@@ -9,11 +9,12 @@ analysis removes with its settling time.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from .._validation import positive
+from .._validation import at_least, positive
 from ..errors import InputError
 from ..recording import Recording
 from .gyro import VirtualGyro
@@ -60,10 +61,19 @@ class TurntableProtocol:
         positive("step_duration", self.step_duration)
         if not set(self.axes) <= {"x", "y", "z"} or not self.axes:
             raise InputError(f"axes must be drawn from 'x', 'y', 'z', got {self.axes!r}")
-        if not self.temps or not self.rates:
-            raise InputError("temps and rates must not be empty")
-        if self.table_tau < 0 or self.temp_noise < 0:
-            raise InputError("table_tau and temp_noise must be >= 0")
+        for name in ("temps", "rates"):
+            values = tuple(float(v) for v in getattr(self, name))
+            if not values or not all(math.isfinite(v) for v in values):
+                raise InputError(f"{{param}} must be one or more finite numbers, got {getattr(self, name)!r}",
+                                 param=name)
+            object.__setattr__(self, name, values)
+        if min(self.rates) < 0:
+            raise InputError(f"{{param}} are magnitudes >= 0 deg/s (each runs forward and reverse), got "
+                             f"{list(self.rates)}", param="rates", value=self.rates)
+        at_least("table_tau", self.table_tau, 0.0, " s")
+        at_least("temp_noise", self.temp_noise, 0.0, " degC")
+        if self.temp_quantum is not None:
+            positive("temp_quantum", self.temp_quantum)
 
     def signed_rates(self) -> np.ndarray:
         """Commanded rates of one position [rad/s]: each magnitude forward then reverse."""

@@ -7,14 +7,14 @@ Each study is one module with ``run(out, ..., progress=None) -> StudyOutput`` an
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Literal, get_args
+from typing import get_args
 
 from ..errors import InputError
+from ..choices import StudyName
 from ._common import Progress, ServoSettings, StudyOutput
 
 __all__ = ["StudyName", "STUDY_NAMES", "run_study", "study_units", "StudyOutput", "ServoSettings"]
 
-StudyName = Literal["servo-normal", "servo-extreme", "servo-speed", "servo-convergence", "thermal-compare"]
 STUDY_NAMES: tuple[str, ...] = get_args(StudyName)
 
 

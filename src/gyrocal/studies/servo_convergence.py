@@ -71,7 +71,7 @@ def run(
     files += write_table(out / "iterations", ["case", "calibrations", "mean iterations", "max iterations",
                                               "iterations:count"], count_rows)
     if plot:
-        from ..plotting._mpl import save_figure
+        from ..plotting import save_figure
         from ..plotting.studies import convergence_figure
 
         save_figure(convergence_figure(cases, title="seed 000 Table I: Algorithm 1 iterates"), out / "convergence.png")

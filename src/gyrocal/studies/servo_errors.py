@@ -71,7 +71,7 @@ def run(
               "CRB std"]
     files = list(write_table(out / "errors", header, rows))
     if plot:
-        from ..plotting._mpl import save_figure
+        from ..plotting import save_figure
         from ..plotting.studies import error_box_figure
 
         fig = error_box_figure(errors, crb, title=f"seed 000 Fig. {2 if condition == 'normal' else 5} "

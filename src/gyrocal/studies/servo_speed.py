@@ -72,7 +72,7 @@ def run(
             for (noise, m) in mse for i, s in enumerate(speeds)]
     files = list(write_table(out / "mse", header, rows))
     if plot:
-        from ..plotting._mpl import save_figure
+        from ..plotting import save_figure
         from ..plotting.studies import mse_speed_figure
 
         fig = mse_speed_figure(speeds, mse, crb, title=f"seed 000 Fig. 4 ({gyros} gyros x {reps} reps per point)")

@@ -104,7 +104,7 @@ def run(
                          [[r["temp"], *[r[f"{m}_rms"] for m in METHODS]] for r in by_temp])
     floor = step_noise_floor(noise, sample_rate, step_duration)
     if plot:
-        from ..plotting._mpl import save_figure
+        from ..plotting import save_figure
         from ..plotting.studies import rms_by_temperature_figure
 
         fig = rms_by_temperature_figure([r["temp"] for r in by_temp],

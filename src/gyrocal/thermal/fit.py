@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import DegenerateDesignError
-from ..models import _KG_COLS, _KG_ROWS
+from ..models import kb_to_kg
 from .session import Steps
 
 __all__ = ["PointFit", "ThermalFit", "fit_point", "fit_session", "kg_eq19", "kg_from_beta", "omega_matrix"]
@@ -40,7 +40,7 @@ def kg_eq19(reference: np.ndarray, means: np.ndarray) -> np.ndarray:
 
 def kg_from_beta(beta: np.ndarray) -> np.ndarray:
     """Kg (..., 12) from per-axis solutions ``beta`` (..., 4, 3): ``beta[c, j] = K[j, c]``, ``beta[3, j] = B[j]``."""
-    return np.concatenate([beta[..., _KG_COLS, _KG_ROWS], beta[..., 3, :]], axis=-1)
+    return kb_to_kg(np.swapaxes(beta[..., :3, :], -1, -2), beta[..., 3, :])
 
 
 @dataclass(frozen=True)

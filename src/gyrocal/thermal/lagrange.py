@@ -14,18 +14,17 @@ outside ``[T_0, T_{n-1}]`` the caller chooses what happens.
 from __future__ import annotations
 
 import warnings
-from typing import Literal
 
 import numpy as np
 
 from .._validation import finite_array
+from ..choices import OutOfRange, values
 from ..errors import InputError, OutOfRangeError
 from ._warn import ThermalRangeWarning
 
 __all__ = ["OutOfRange", "RANGE_MARGIN", "check_nodes", "interpolate", "lagrange_weights", "range_policy", "stencil"]
 
-OutOfRange = Literal["refuse", "clamp", "extrapolate"]
-_POLICIES = ("refuse", "clamp", "extrapolate")
+_POLICIES = values(OutOfRange)
 
 #: Readings this close to the end nodes [degC] count as at them (GYROCAL_THERMAL_MARGIN in C).
 RANGE_MARGIN = 0.5
@@ -43,7 +42,8 @@ def check_nodes(nodes) -> np.ndarray:
 
 def range_policy(nodes: np.ndarray, temp: np.ndarray, out_of_range: OutOfRange) -> np.ndarray:
     if out_of_range not in _POLICIES:
-        raise InputError(f"out_of_range={out_of_range!r} is not one of {', '.join(_POLICIES)}")
+        raise InputError(f"{{param}}={out_of_range!r} is not one of {', '.join(_POLICIES)}", param="out_of_range",
+                         value=out_of_range)
     lo, hi = nodes[0], nodes[-1]
     outside = (temp < lo - RANGE_MARGIN) | (temp > hi + RANGE_MARGIN)
     if not outside.any():
@@ -51,7 +51,8 @@ def range_policy(nodes: np.ndarray, temp: np.ndarray, out_of_range: OutOfRange) 
     worst = float(temp[outside][np.argmax(np.abs(temp[outside] - (lo + hi) / 2))])
     where = f"{int(outside.sum())} temperature reading(s) outside the calibrated range [{lo:g}, {hi:g}] degC, e.g. {worst:.2f} degC"
     if out_of_range == "refuse":
-        raise OutOfRangeError(f"{where}; pass out_of_range='clamp' or 'extrapolate' to accept them")
+        raise OutOfRangeError(where, param="out_of_range", value=out_of_range,
+                              hint="set {param} to 'clamp' or 'extrapolate' to accept them")
     warnings.warn(f"{where}; {'clamped to the nearest end' if out_of_range == 'clamp' else 'extrapolated'}",
                   ThermalRangeWarning, stacklevel=3)
     return np.clip(temp, lo, hi) if out_of_range == "clamp" else temp

@@ -85,7 +85,7 @@ def write_report(cal: ThermalCalibration, evaluation: Evaluation, out_dir: str |
 
 
 def _figures(cal, evaluation, out: Path, unit: str, truth) -> list[Path]:
-    from ..plotting._mpl import save_figure
+    from ..plotting import save_figure
     from ..plotting.thermal import plot_coefficients, plot_error_vs_rate, plot_error_vs_temperature
 
     paths = []
