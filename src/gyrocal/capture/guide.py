@@ -90,7 +90,7 @@ class Guide:
 
     def __init__(self, name: str, *, speed: float | None = None, angle: float = 2 * math.pi, settle: float = 1.0):
         if name not in GUIDES:
-            raise InputError(f"guide must be one of {', '.join(GUIDES)}, got {name!r}")
+            raise InputError(f"{{param}} must be one of {', '.join(GUIDES)}, got {name!r}", param="guide", value=name)
         self.name, self.steps = name, GUIDES[name]
         self.speed, self.angle, self.settle = speed, angle, settle
         self.index = 0
@@ -130,7 +130,7 @@ class Guide:
         outcome does not depend on how the samples arrived in chunks.
         """
         fs = rec.sample_rate
-        stride = max(1, int(round(every * fs)))
+        stride = max(1, round(every * fs))
         events: list[GuideEvent] = []
         while not self.complete and self._checked + stride <= len(rec):
             self._checked += stride

@@ -13,12 +13,10 @@ from typing import Annotated
 
 import typer
 
+from ..choices import CaptureWire, GuideName, InputUnit
 from ..errors import GyrocalError, InputError
 from ._outputs import check_output
 from .app import app, console, warn
-
-_WIRES = ("auto", "frames", "text")
-_UNITS = ("counts", "deg/s", "rad/s")
 
 
 class _Stop:
@@ -113,8 +111,8 @@ class _Guided:
         if len(store) < 2:
             return False
         if self.units == "counts" and sens is None:
-            raise InputError("--guide needs the sensitivity to check the turns' angles: the device's hello frame "
-                             "carries it; for text lines give --sensitivity LSB")
+            raise InputError("the guide needs the sensitivity to check the turns' angles (the device's hello frame "
+                             "carries it)", param="sensitivity", hint="for text lines in counts give {param} LSB")
         self.sensitivity = sens
         self._events(self.guide.update(store.recording(self.units, sens, self.sample_rate)))
         return self.guide.complete
@@ -156,11 +154,11 @@ def capture(
                                       "socket://HOST:PORT (anything pyserial opens).")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Recording to write (CSV: t, gx, gy, gz[, temp]).")],
     baud: Annotated[int, typer.Option("--baud", help="Baud rate [bit/s].")] = 115200,
-    wire: Annotated[str, typer.Option("--wire", help="Wire format: auto, frames (gyrocal frames) or text "
+    wire: Annotated[CaptureWire, typer.Option("--wire", help="Wire format: auto, frames (gyrocal frames) or text "
                                       "(lines such as t,gx,gy,gz).")] = "auto",
     columns: Annotated[str | None, typer.Option("--columns", help="Text lines without a header: column "
                                                    "numbers from 1, e.g. t=1,gx=2,gy=3,gz=4.")] = None,
-    units: Annotated[str, typer.Option("--units", help="Unit of the rates received: counts, deg/s or rad/s "
+    units: Annotated[InputUnit, typer.Option("--units", help="Unit of the rates received: counts, deg/s or rad/s "
                                        "(frames always send counts).")] = "counts",
     sensitivity: Annotated[float | None, typer.Option("--sensitivity", help="Counts per deg/s (frames: the "
                                                          "device says).")] = None,
@@ -170,7 +168,7 @@ def capture(
     samples: Annotated[int | None, typer.Option("--samples", help="Stop after N samples.")] = None,
     silence: Annotated[float | None, typer.Option("--silence", help="Stop after S seconds without a "
                                                      "byte.")] = None,
-    guide: Annotated[str | None, typer.Option("--guide", help="Guided session: servo (the six turns of the "
+    guide: Annotated[GuideName | None, typer.Option("--guide", help="Guided session: servo (the six turns of the "
                                                  "servo method of Wang et al.) or hand.")] = None,
     speed: Annotated[float | None, typer.Option("--speed", help="Known turn speed [deg/s] (servo); default "
                                                    "whole 360 deg turns at any speed.")] = None,
@@ -182,10 +180,6 @@ def capture(
     """Record a live stream from a serial port; with --guide, walk through a calibration and calibrate."""
     from ..capture.recorder import Capture
 
-    if wire not in _WIRES:
-        raise InputError(f"--wire must be one of {', '.join(_WIRES)}, got {wire!r}")
-    if units not in _UNITS:
-        raise InputError(f"--units must be one of {', '.join(_UNITS)}, got {units!r}")
     if columns:
         from ..io.columns import parse_columns
 
@@ -217,9 +211,9 @@ def _finish(result, port, units, sensitivity, sample_rate, guided, cal_path, spe
     calibrate_args = {"units": units, "sensitivity": sens, "sample_rate": sample_rate}
     if guided is not None and guided.guide.complete:
         run = calibrate_capture(result.path, windows=guided.guide.windows(), speed=speed_rad, **calibrate_args)
-        from ..calibration import save_calibration
+        from ..files import save
 
-        save_calibration(run.calibration, cal_path)
+        save(run.calibration, cal_path)
         console.print(run.report(), highlight=False, soft_wrap=True, markup=False)
         console.print(f"wrote {cal_path}", highlight=False, markup=False)
     elif guided is not None:
