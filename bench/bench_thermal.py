@@ -1,4 +1,4 @@
-"""Benchmark: fit a paper-size seed 001 session (10 temperatures x 3 positions x 21 rates).
+"""Benchmark: fit a paper-size session of the full-temperature-range method (10 temperatures x 3 positions x 21 rates).
 
 Run by hand:  python bench/bench_thermal.py [--step-duration 60] [--sample-rate 200]
 

@@ -40,7 +40,7 @@ def _within_4_sigma(cal, truth=TRUE):
 
 @pytest.fixture(scope="module")
 def servo_csv(tmp_path_factory):
-    """Seed 000's protocol at 60 deg/s, 200 Hz, ramps and vibration, 5 deg misaligned, in deg/s."""
+    """The servo method's protocol at 60 deg/s, 200 Hz, ramps and vibration, 5 deg misaligned, in deg/s."""
     rng = np.random.default_rng(3)
     rec, truth = _simulate(rng, ServoProtocol(misalignment_deg=5.0))
     path = tmp_path_factory.mktemp("servo") / "rec.csv"

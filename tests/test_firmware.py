@@ -59,7 +59,7 @@ solution_tolerance = solution_bound  # the same bound gyrocal capture holds a de
 
 
 def simulated(rng, n_gyros: int = 4) -> tuple[ObservationSet, np.ndarray, np.ndarray]:
-    """Seed 000's simulation settings (section III-A), per sample, for a few random gyros."""
+    """The servo method's simulation settings (section III-A), per sample, for a few random gyros."""
     k = rng.uniform(0.8, 1.2, (n_gyros, 3))
     b = rng.uniform(-0.1, 0.1, (n_gyros, 3))
     return paper_observations(k, b, speed=np.pi / 3, rng=rng), k, b
@@ -72,7 +72,7 @@ def test_algorithm1_matches_python(clib, rng):
         k, b, iterations = clib.algorithm1(obs.mean_sq[i], obs.mean[i], obs.rate[i])
         tol = solution_tolerance(ref.k[i], ref.b[i], obs.mean_sq[i], obs.mean[i], obs.rate[i] ** 2)
         assert np.all(np.abs(np.concatenate([k, b]) - ref.params[i]) <= tol)
-        assert 1 <= iterations <= 10  # seed 000, Table I: a handful
+        assert 1 <= iterations <= 10  # the servo method of Wang et al., Table I: a handful
 
 
 def test_first_moment_matches_python(clib, rng):
@@ -232,7 +232,7 @@ def test_affine_correction_matches_python(clib, rng):
 
 
 def thermal_table(rng, units: str = "deg/s") -> ThermalCalibration:
-    """Seed 001 Table 1 temperatures; Kg a smooth trend around an identity-like gyro plus fit noise."""
+    """The full-temperature-range method, Table 1 temperatures; Kg a smooth trend around an identity-like gyro plus fit noise."""
     temps = np.arange(-40.0, 51.0, 10.0)
     u = (temps[:, None] - 5.0) / 45.0
     base = np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
@@ -242,7 +242,7 @@ def thermal_table(rng, units: str = "deg/s") -> ThermalCalibration:
 
 
 def _k_matrix(v9: np.ndarray) -> np.ndarray:
-    """K (..., 3, 3) from the first nine Kg elements (seed 001, eq. 11)."""
+    """K (..., 3, 3) from the first nine Kg elements (the full-temperature-range method, eq. 11)."""
     K = np.zeros(v9.shape[:-1] + (3, 3))
     for e, (row, col) in enumerate(KG_INDEX):
         K[..., row, col] = v9[..., e]

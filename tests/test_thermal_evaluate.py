@@ -1,4 +1,4 @@
-"""Evaluation like seed 001's Tables 3-4 and Figures 4-9, the report folder, and the figures."""
+"""Evaluation like the full-temperature-range method's Tables 3-4 and Figures 4-9, the report folder, and the figures."""
 
 import dataclasses
 

@@ -39,7 +39,7 @@ class Observation:
     mean : ndarray, shape (3,)
         Window mean of the readings [reading units].
     mean_sq : ndarray, shape (3,)
-        Window mean of the squared readings [reading units^2] (seed 000 eq. 8 regressors).
+        Window mean of the squared readings [reading units^2] (the servo method of Wang et al., eq. 8 regressors).
     noise_var : ndarray, shape (3,)
         Per-sample white-noise variance, from first differences [reading units^2].
         Differencing removes the rotation itself, ramps and slow vibration.

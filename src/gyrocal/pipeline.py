@@ -8,7 +8,7 @@ Method S, first-moment form). A windows file overrides detection.
 Which windows each method uses:
 
 * ``first-moment``: rotations and static windows (static windows give ``m = -b``).
-* ``algorithm1`` and ``lm`` (seed 000's mean-of-squares regression, eq. 4-8): rotations
+* ``algorithm1`` and ``lm`` (the servo method's mean-of-squares regression, eq. 4-8): rotations
   only. A static row would read ``y = 0`` against ``k^2 mean(m^2)``, which holds the noise
   power ``k^2 sigma^2``, so static rows would add bias, not information.
 """

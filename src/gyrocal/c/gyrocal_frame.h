@@ -64,7 +64,7 @@ typedef struct {
     char firmware[16];  /* firmware name and version, NUL-padded (need not be terminated) */
 } gyrocal_hello_t;
 
-/* Slots of the six turns, in seed 000's order (+x, -x, +y, -y, +z, -z). */
+/* Slots of the six turns, in the servo method's order (+x, -x, +y, -y, +z, -z). */
 typedef struct {
     uint32_t start;     /* first sample (the sample frames' seq) */
     uint32_t stop;      /* one past the last sample */

@@ -235,7 +235,7 @@ class CLibrary:
         return np.array(out.k, np.float32), np.array(out.b, np.float32), it.value
 
     def algorithm1(self, mean_sq, mean, rate) -> tuple[np.ndarray, np.ndarray, int]:
-        """Seed 000 Algorithm 1 on six windows; ``(k, b, iterations)``."""
+        """The servo method of Wang et al., Algorithm 1 on six windows; ``(k, b, iterations)``."""
         return self._six("gyrocal_algorithm1", mean, mean_sq, rate)
 
     def first_moment(self, mean, rate) -> tuple[np.ndarray, np.ndarray, int]:

@@ -57,7 +57,7 @@ RULE = ("3-node Lagrange (the full-temperature-range method, eq. 21-22): i = fir
 @register
 @dataclass(frozen=True)
 class ThermalCalibration:
-    """A gyro calibrated at several temperatures (seed 001).
+    """A gyro calibrated at several temperatures (the full-temperature-range method).
 
     Parameters
     ----------
