@@ -9,6 +9,7 @@ from ._result import BatchFit, FitResult, Method
 from .algorithm1 import Algorithm1, algorithm1_batch
 from .first_moment import FirstMoment, first_moment_batch
 from .paper_lm import PaperLM, paper_lm_batch
+from .residuals import window_residuals
 
 __all__ = [
     "Algorithm1",
@@ -23,6 +24,7 @@ __all__ = [
     "paper_lm_batch",
     "require_count",
     "require_full_rank",
+    "window_residuals",
 ]
 
 
