@@ -10,13 +10,12 @@ import json
 import numpy as np
 import pytest
 import yaml
-
-from gyrocal.files import load
-from gyrocal.noise import NoiseReport
-
 from cli_runner import invoke, refused  # noqa: E402
 from dataflash_writer import imu_log  # noqa: E402
 from firmware_models import ardupilot_correct, parse_ardupilot, parse_px4, px4_offsets  # noqa: E402
+
+from gyrocal.files import load
+from gyrocal.noise import NoiseReport
 
 
 @pytest.fixture(scope="module")

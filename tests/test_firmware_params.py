@@ -7,11 +7,10 @@ float32 parameters and arithmetic allow.
 
 import numpy as np
 import pytest
+from firmware_models import ardupilot_correct, parse_ardupilot, parse_px4, px4_offsets  # noqa: E402
 
 from gyrocal.errors import InputError
 from gyrocal.flight import ScaleNotCarriedWarning, ThermalBias, ardupilot_params, bias_from_thermal, px4_params
-
-from firmware_models import ardupilot_correct, parse_ardupilot, parse_px4, px4_offsets  # noqa: E402
 
 F32 = np.float32
 EPS32 = float(np.finfo(np.float32).eps)

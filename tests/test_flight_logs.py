@@ -10,13 +10,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from dataflash_writer import imu_log  # noqa: E402
+from firmware_models import ardupilot_correct  # noqa: E402
 
 from gyrocal.errors import InputError, UnitError
 from gyrocal.io import read_flight_log, read_recording
 from gyrocal.io.dataflash import DataFlashWarning
-
-from dataflash_writer import imu_log  # noqa: E402
-from firmware_models import ardupilot_correct  # noqa: E402
 
 ULOG = Path(__file__).parent / "data" / "px4_ulog" / "sample_log_small.ulg"
 

@@ -14,8 +14,15 @@ import pytest
 
 from gyrocal.errors import FileFormatError, InputError, UnitError
 from gyrocal.models import ScaleBias
-from gyrocal.noise import (BI_FACTOR, NoiseWarning, characterise, characterise_recording, load_noise,
-                           noise_density_arg, save_noise)
+from gyrocal.noise import (
+    BI_FACTOR,
+    NoiseWarning,
+    characterise,
+    characterise_recording,
+    load_noise,
+    noise_density_arg,
+    save_noise,
+)
 from gyrocal.recording import Recording
 from gyrocal.simulation import VirtualGyro
 

@@ -72,6 +72,15 @@ FLAGS: dict[str, str] = {
     "device_id": "--device-id",
     "caltemp": "--caltemp",
     "name": "--name",
+    # capture, simulate --device
+    "port": "--port",
+    "baud": "--baud",
+    "wire": "--wire",
+    "samples": "--samples",
+    "silence": "--silence",
+    "guide": "--guide",
+    "faults": "--faults",
+    "pace": "--pace",
 }
 
 #: Parameters that library errors name but that no flag sets (the command line fills them itself).

@@ -25,8 +25,8 @@ import os
 
 import numpy as np
 
-from .._version import __version__
 from .._jsonfile import check_header, get, get_array
+from .._version import __version__
 from ..errors import FileFormatError, InputError
 from ..files import load, register, save
 from .thermal_bias import MAX_ORDER, ThermalBias

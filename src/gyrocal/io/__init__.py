@@ -6,11 +6,11 @@ extra) logs. Everything comes back as a checked
 :class:`~gyrocal.recording.Recording` in internal units.
 """
 
+from ..saturation import find_saturation
 from .flightlog import read_flight_log
 from .profile import read_profile
 from .reader import read_recording
 from .session import read_session
-from ..saturation import find_saturation
 from .windowsfile import read_windows
 from .writer import recording_columns, write_csv, write_recording
 

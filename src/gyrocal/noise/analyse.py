@@ -10,6 +10,7 @@ would join different bias levels with steps that read as noise.
 from __future__ import annotations
 
 import warnings
+
 import numpy as np
 
 from .._validation import finite_array, positive
