@@ -198,7 +198,7 @@ def test_zero_density_files_are_refused(report, tmp_path):
     path.write_text(json.dumps(doc))
     with pytest.raises(FileFormatError, match="gyroscope.y.density.value' must be a number > 0"):
         load_noise(path)
-    with pytest.raises(FileFormatError, match="> 0"):
+    with pytest.raises(InputError, match="gives a zero noise density on y"):
         noise_density_arg(str(path))
 
 

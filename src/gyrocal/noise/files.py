@@ -8,7 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from .._jsonfile import read_json
+from ..errors import FileFormatError, InputError
 from ..files import load, save
 from .report import NoiseReport
 
@@ -31,6 +32,16 @@ def load_noise(path: str | os.PathLike) -> NoiseReport:
     return load(path, NoiseReport)
 
 
+def _zero_axes(path: str) -> list[str]:
+    """The gyro axes whose density a noise file (version 1 or 2) gives as zero or less."""
+    doc = read_json(path)
+    if doc.get("version") == 1:
+        values = doc.get("arw") or []
+    else:
+        values = [((doc.get("gyroscope") or {}).get(a) or {}).get("density", {}).get("value") for a in "xyz"]
+    return [a for a, v in zip("xyz", values) if isinstance(v, (int, float)) and not v > 0]
+
+
 def noise_density_arg(value: str) -> np.ndarray:
     """Parse a ``--noise-density`` option into a per-axis gyro density (3,) [rad/s/sqrt(Hz)].
 
@@ -39,7 +50,15 @@ def noise_density_arg(value: str) -> np.ndarray:
     """
     text = str(value).strip()
     if text.lower().endswith(".json") or Path(text).is_file():
-        return load_noise(text).density
+        try:
+            return load_noise(text).density
+        except FileFormatError as exc:
+            zero = _zero_axes(text)
+            if not zero:
+                raise
+            raise InputError(f"{{param}} {text} gives a zero noise density on {', '.join(zero)}, which would give a "
+                             "zero 1-sigma (a noise file of all-zero or constant data?)", param="noise_density",
+                             value=text, hint="measure the noise on a real static log (gyrocal noise)") from exc
     number, factor = text, 1.0
     for suffix in _DEG_SUFFIXES:
         if text.lower().endswith(suffix):
