@@ -14,15 +14,8 @@ import pytest
 
 from gyrocal.errors import FileFormatError, InputError, UnitError
 from gyrocal.models import ScaleBias
-from gyrocal.noise import (
-    BI_FACTOR,
-    NoiseWarning,
-    characterise,
-    characterise_recording,
-    load_noise,
-    noise_density_arg,
-    save_noise,
-)
+from gyrocal.noise import BI_FACTOR, NoiseWarning, characterise, characterise_recording
+from gyrocal.noise_file import load_noise, noise_density_arg, save_noise
 from gyrocal.recording import Recording
 from gyrocal.simulation import VirtualGyro
 

@@ -29,8 +29,8 @@ KIND_MODULES: dict[str, str] = {
     "gyrocal.calibration": "gyrocal.calibration",
     "gyrocal.thermal": "gyrocal.thermal.model",
     "gyrocal.simulation-truth": "gyrocal.simulation.truth",
-    "gyrocal.noise": "gyrocal.noise.report",
-    "gyrocal.thermal-bias": "gyrocal.flight.bias_file",
+    "gyrocal.noise": "gyrocal.noise_file",
+    "gyrocal.thermal-bias": "gyrocal.thermal_bias_file",
 }
 
 _KINDS: dict[str, type] = {}

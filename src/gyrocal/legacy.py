@@ -17,7 +17,7 @@ reader of files accepts old ones. The steps, and what changed:
 ``gyrocal.noise`` 1 -> 2
     Per-axis gyro lists (``arw``, ``bias_instability``, ``rrw``) become figures per axis and
     for the sensor (``gyroscope.x.density.value``, ...) with intervals (null: unknown); the
-    accelerometer section appears (null). See :func:`gyrocal.noise.report.upgrade_v1`.
+    accelerometer section appears (null). See :func:`gyrocal.noise_file.upgrade_v1`.
 """
 
 from __future__ import annotations
@@ -80,7 +80,7 @@ def _thermal_1_to_2(doc: dict, path) -> dict:
 
 
 def _noise_1_to_2(doc: dict, path) -> dict:
-    from .noise.report import upgrade_v1
+    from .noise_file import upgrade_v1
 
     return upgrade_v1(doc, path)
 

@@ -76,7 +76,8 @@ def noise(
     = False,
 ) -> None:
     """Allan deviation of a log at rest: noise density, bias instability and random walk, with intervals."""
-    from ..noise import FORMAT, characterise_recording, save_noise
+    from ..noise import FORMAT, characterise_recording
+    from ..noise_file import save_noise
     from ..units import parse_rate_unit, unit_factor
 
     # every output is checked before anything is read, computed or written

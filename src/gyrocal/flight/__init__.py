@@ -7,9 +7,11 @@
   written so that they evaluate exactly gyrocal's bias polynomial.
 * :func:`kalibr_yaml`, :func:`vins_yaml`, :func:`imu_utils_yaml`: noise files from a
   :class:`~gyrocal.noise.NoiseReport`.
+
+The thermal-bias file is :mod:`gyrocal.thermal_bias_file`; the exporters are registered by
+:mod:`gyrocal.flight_exporters`.
 """
 
-from .bias_file import load_thermal_bias, save_thermal_bias
 from .firmware_params import ardupilot_params, px4_params
 from .from_table import ScaleNotCarriedWarning, bias_from_thermal
 from .temperature import TemperatureCourse, temperature_course
@@ -27,9 +29,7 @@ __all__ = [
     "fit_thermal_bias",
     "imu_utils_yaml",
     "kalibr_yaml",
-    "load_thermal_bias",
     "px4_params",
-    "save_thermal_bias",
     "temperature_course",
     "vins_yaml",
     "vio_values",

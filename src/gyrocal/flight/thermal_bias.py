@@ -86,20 +86,20 @@ class ThermalBias:
     source: dict = field(default_factory=dict)
     warnings: tuple[str, ...] = ()
 
-    #: File kind (registered by :mod:`.bias_file`, which holds the document code).
+    #: File kind (registered by :mod:`gyrocal.thermal_bias_file`, which holds the document code).
     FORMAT: ClassVar[str] = "gyrocal.thermal-bias"
     VERSION: ClassVar[int] = 1
 
     def to_document(self) -> dict:
         """The JSON-ready document (``format: gyrocal.thermal-bias``)."""
-        from .bias_file import to_document
+        from ..thermal_bias_file import to_document
 
         return to_document(self)
 
     @classmethod
-    def from_document(cls, doc: dict, path="document") -> "ThermalBias":
+    def from_document(cls, doc: dict, path="document") -> ThermalBias:
         """Validate a document and rebuild the fit, naming any bad field."""
-        from .bias_file import from_document
+        from ..thermal_bias_file import from_document
 
         return from_document(doc, path)
 

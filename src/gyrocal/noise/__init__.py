@@ -4,14 +4,14 @@
 moves is cut to its longest still stretch with a warning), computes the overlapping Allan
 deviation of each gyro and accelerometer axis (``allantools``) and reads the white-noise
 density, the bias instability and the random walk of the bias for each axis and for the
-sensor, each with a confidence interval from the equivalent degrees of freedom.
+sensor, each with a confidence interval from the equivalent degrees of freedom. The report's
+file is :mod:`gyrocal.noise_file` (``save_noise``, ``load_noise``, ``noise_density_arg``).
 """
 
 from .allan import ONE_SIGMA, allan_deviation
 from .analyse import MotionPolicy, NoiseWarning, characterise, characterise_recording
 from .figures import BI_FACTOR, Figure
-from .files import load_noise, noise_density_arg, save_noise
-from .report import FORMAT, VERSION, NoiseReport, SensorNoise, from_document, to_document
+from .report import FORMAT, VERSION, NoiseReport, SensorNoise
 
 __all__ = [
     "BI_FACTOR",
@@ -26,9 +26,4 @@ __all__ = [
     "allan_deviation",
     "characterise",
     "characterise_recording",
-    "from_document",
-    "load_noise",
-    "noise_density_arg",
-    "save_noise",
-    "to_document",
 ]

@@ -25,11 +25,11 @@ import os
 
 import numpy as np
 
-from .._jsonfile import check_header, get, get_array
-from .._version import __version__
-from ..errors import FileFormatError, InputError
-from ..files import load, register, save
-from .thermal_bias import MAX_ORDER, ThermalBias
+from ._jsonfile import check_header, get, get_array
+from ._version import __version__
+from .errors import FileFormatError, InputError
+from .files import load, register, save
+from .flight.thermal_bias import MAX_ORDER, ThermalBias
 
 __all__ = ["FORMAT", "VERSION", "from_document", "load_thermal_bias", "save_thermal_bias", "to_document"]
 

@@ -3,19 +3,20 @@
 ``kalibr``, ``vins``, ``imu_utils`` take a noise file (:class:`~gyrocal.noise.NoiseReport`);
 ``px4`` and ``ardupilot`` take a thermal-bias file (:class:`~.thermal_bias.ThermalBias`) or the
 bias part of a turntable calibration (``gyrocal.thermal``, with a warning that scale and
-misalignment against temperature are left behind).
+misalignment against temperature are left behind). The text itself comes from
+:mod:`gyrocal.flight.vio` and :mod:`gyrocal.flight.firmware_params`.
 """
 
 from __future__ import annotations
 
-from .._validation import refuse_options
-from ..export import register_exporter
-from ..noise import NoiseReport
-from ..thermal.model import ThermalCalibration
-from .firmware_params import ardupilot_params, px4_params
-from .from_table import bias_from_thermal
-from .thermal_bias import ThermalBias
-from .vio import imu_utils_yaml, kalibr_yaml, vins_yaml
+from ._validation import refuse_options
+from .export import register_exporter
+from .flight.firmware_params import ardupilot_params, px4_params
+from .flight.from_table import bias_from_thermal
+from .flight.thermal_bias import ThermalBias
+from .flight.vio import imu_utils_yaml, kalibr_yaml, vins_yaml
+from .noise.report import NoiseReport
+from .thermal.model import ThermalCalibration
 
 __all__ = ["ardupilot", "imu_utils", "kalibr", "px4", "vins"]
 
