@@ -26,13 +26,14 @@ from .calibration import Calibration
 from .errors import InputError
 from .estimators import FitResult, make_estimator
 from .observations import Observation, ObservationSet, observe
+from .observed import observe as observe_data
 from .recording import Recording
 from .segmentation import Segmentation, segment
 from .segmentation._motion import static_level
 from .units import parse_input_unit, parse_rate_unit, unit_factor
 from .windows import Window
 
-__all__ = ["CalibrationRun", "calibrate"]
+__all__ = ["CalibrationRun", "calibrate", "parameter_rows"]
 
 
 @dataclass(frozen=True)
@@ -62,18 +63,8 @@ class CalibrationRun:
     reference_value: float
 
     def parameters(self) -> list[tuple[str, float, float, str]]:
-        """``(name, value, 1-sigma, unit)`` of k and b in user units (sigma NaN if unknown)."""
-        cal = self.calibration
-        c, d = cal.input_scale, unit_factor(cal.output_units)
-        p = cal.model.params
-        std = cal.std if cal.std is not None else np.full(len(p), np.nan)
-        k_unit = "1" if cal.input_units == cal.output_units else f"{cal.output_units} per {cal.input_units}"
-        rows = []
-        for j, axis in enumerate("xyz"):
-            rows.append((f"k{axis}", p[j] * c / d, std[j] * c / d, k_unit))
-        for j, axis in enumerate("xyz"):
-            rows.append((f"b{axis}", p[3 + j] / c, std[3 + j] / c, cal.input_units))
-        return rows
+        """``(name, value, 1-sigma, unit)`` of k and b in user units (see :func:`parameter_rows`)."""
+        return parameter_rows(self.calibration)
 
     def scale_bias_note(self) -> str | None:
         """For the paper's mean-of-squares methods, how low they read k (SPEC); None otherwise."""
@@ -196,6 +187,28 @@ def _observe(rec: Recording, w: Window, reference: str, speed) -> Observation:
     return observe(samples, fs, "angle", angle=w.angle, t=_gap_times(rec, w))
 
 
+
+def parameter_rows(cal: Calibration) -> list[tuple[str, float, float, str]]:
+    """``(name, value, 1-sigma, unit)`` of k and b (Wang et al., eq. 1) in user units (sigma NaN if unknown).
+
+    k and b are what the file stores (``parameters``), in the user's units: with counts and a
+    sensitivity, k is relative to that sensitivity (1 = as declared) and b is in the output unit,
+    as the counts were converted before the fit; with counts alone, k absorbs the sensitivity
+    (output unit per count) and b is in counts.
+    """
+    p = cal.model.params
+    std = cal.std if cal.std is not None else np.full(len(p), np.nan)
+    d = unit_factor(cal.output_units)
+    if cal.input_units == "counts" and cal.sensitivity is not None:
+        k_scale, b_scale, k_unit, b_unit = 1.0, 1.0 / d, "1", cal.output_units
+    else:
+        c = cal.input_scale
+        k_scale, b_scale, b_unit = c / d, 1.0 / c, cal.input_units
+        per = "count" if cal.input_units == "counts" else cal.input_units
+        k_unit = "1" if cal.input_units == cal.output_units else f"{cal.output_units} per {per}"
+    rows = [(f"k{axis}", p[j] * k_scale, std[j] * k_scale, k_unit) for j, axis in enumerate("xyz")]
+    return rows + [(f"b{axis}", p[3 + j] * b_scale, std[3 + j] * b_scale, b_unit) for j, axis in enumerate("xyz")]
+
 def calibrate(
     rec: Recording,
     *,
@@ -265,4 +278,7 @@ def calibrate(
         noise_std=fit.noise_std,
         windows=tuple({**w.to_dict(), "rate": o.rate} for w, o in zip(used, observations)),
     )
+    # what the data looked like, so that apply can catch data in another unit later
+    cal = dataclasses.replace(cal, observed=observe_data(rec.gyro / cal.input_scale, rec.sample_rate,
+                                                            input_units))
     return CalibrationRun(cal, fit, seg, observations, reference, value)
