@@ -11,8 +11,8 @@ import math
 
 import numpy as np
 import pytest
-
 from cli_runner import invoke, refused
+
 from gyrocal.files import load_calibration
 from gyrocal.io import write_csv
 from gyrocal.models import ScaleBias
@@ -45,7 +45,7 @@ def test_the_calibration_records_what_its_data_looked_like(session):
     observed = load_calibration(session / "cal.json").observed
     assert observed["units"] == "deg/s" and observed["sample_rate"] == pytest.approx(200.0)
     # pooled over ~4000 still samples: relative sd ~1.2 %; 4 sigma
-    np.testing.assert_allclose(observed["noise_std"], math.degrees(NOISE), rtol=0.05)
+    np.testing.assert_allclose(observed["quiet_noise_std"], math.degrees(NOISE), rtol=0.05)
     assert all(60 < v < 90 for v in observed["max_abs_rate"])
 
 

@@ -22,7 +22,7 @@ from gyrocal.models import ScaleBias
 from gyrocal.observations import ObservationSet
 from gyrocal.simulation.windows import PAPER_AXES, paper_observations
 
-SPEED = math.pi / 3  # 60 deg/s, seed 000 section III-A
+SPEED = math.pi / 3  # 60 deg/s, the servo method of Wang et al., section III-A
 SIGMA = 0.035
 
 
@@ -189,7 +189,7 @@ def test_results_are_frozen(rng):
             getattr(fit, name)[0] = 0
 
 
-# --- errors (issue 2, item 5) ---
+# --- errors: one sentence naming the argument (docs/core.md, Estimators) ---
 
 
 def test_all_rotations_about_one_axis_is_degenerate(rng):

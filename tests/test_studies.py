@@ -44,7 +44,7 @@ def test_first_moment_reaches_the_cramer_rao_bound(normal):
 
 
 def test_algorithm1_equals_lm_with_six_observations(normal):
-    """Six equations fix six unknowns, so both solvers land on the same point (seed 000, Fig. 2)."""
+    """Six equations fix six unknowns, so both solvers land on the same point (the servo method of Wang et al., Fig. 2)."""
     out, _, _ = normal
     rows = _rows(out / "errors.csv")
     alg = {(r["noise [rad/s]"], r["param"]): float(r["rms"]) for r in rows if r["method"] == "Algorithm 1"}

@@ -7,8 +7,8 @@ stores each in the canonical form
 
 and keeps each paper's own parameters, converting exactly in both directions:
 
-* :class:`ScaleBias` (seed 000, eq. 1): ``g = diag(k) (m + b)``, so ``A = diag(k)``, ``o = -b``.
-* :class:`Affine` (seed 001, eq. 12): ``w = K w~ + B``, so ``A = K^-1``, ``o = B``.
+* :class:`ScaleBias` (the servo method of Wang et al., eq. 1): ``g = diag(k) (m + b)``, so ``A = diag(k)``, ``o = -b``.
+* :class:`Affine` (the full-temperature-range method, eq. 12): ``w = K w~ + B``, so ``A = K^-1``, ``o = B``.
 
 Models are unit-agnostic numbers: ``o`` is in the units of the readings and ``A``
 maps reading units to output units. The package keeps both in rad/s inside; files
@@ -28,7 +28,7 @@ from .errors import InputError, NonPhysicalEstimateError
 
 __all__ = ["KG_INDEX", "KG_NAMES", "Affine", "CalibrationModel", "ScaleBias", "correct", "kb_to_kg", "kg_to_kb"]
 
-#: Seed 001 eq. 14: element order of the 12-vector Kg.
+#: The full-temperature-range method, eq. 14: element order of the 12-vector Kg.
 KG_NAMES: tuple[str, ...] = ("Kxx", "Kyy", "Kzz", "Kyx", "Kzx", "Kxy", "Kzy", "Kxz", "Kyz", "Bx", "By", "Bz")
 #: Position in K (eq. 11) of each of the first nine Kg elements.
 #: K = [[Kxx, Kyx, Kzx], [Kxy, Kyy, Kzy], [Kxz, Kyz, Kzz]], so row = output axis, column = input axis.
@@ -62,7 +62,7 @@ def correct(matrix: np.ndarray, offset: np.ndarray, readings) -> np.ndarray:
 
 @dataclass(frozen=True)
 class ScaleBias:
-    """Per-axis scale and bias, seed 000 eq. 1: ``g = diag(k) (m + b)``.
+    """Per-axis scale and bias, the servo method of Wang et al., eq. 1: ``g = diag(k) (m + b)``.
 
     Parameters
     ----------
@@ -133,7 +133,7 @@ class ScaleBias:
 
 @dataclass(frozen=True)
 class Affine:
-    """Full 12-parameter model, seed 001 eq. 12: ``w = K w~ + B``.
+    """Full 12-parameter model, the full-temperature-range method, eq. 12: ``w = K w~ + B``.
 
     Parameters
     ----------
@@ -169,7 +169,7 @@ class Affine:
 
     @property
     def kg(self) -> np.ndarray:
-        """Seed 001 eq. 14 12-vector ``[Kxx, Kyy, Kzz, Kyx, Kzx, Kxy, Kzy, Kxz, Kyz, Bx, By, Bz]``."""
+        """The full-temperature-range method, eq. 14 12-vector ``[Kxx, Kyy, Kzz, Kyx, Kzx, Kxy, Kzy, Kxz, Kyz, Bx, By, Bz]``."""
         return kb_to_kg(self.K, self.B)
 
     @property
@@ -179,7 +179,7 @@ class Affine:
 
     @classmethod
     def from_kg(cls, kg) -> Affine:
-        """Build from the seed 001 12-vector (eq. 14 order)."""
+        """Build from the full-temperature-range method 12-vector (eq. 14 order)."""
         return cls(*kg_to_kb(finite_array("kg", kg, shape_tail=(12,), ndim=1)))
 
     from_params = from_kg

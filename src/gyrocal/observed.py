@@ -52,15 +52,16 @@ def quiet_noise(raw: np.ndarray, sample_rate: float) -> np.ndarray:
 
 
 def observe(raw: np.ndarray, sample_rate: float, units: str) -> dict:
-    """The ``observed`` section of a calibration from its data ``raw`` (N, 3) [input `units`]."""
+    """The facts :func:`check_observed` compares, from data ``raw`` (N, 3) [input `units`]."""
     raw = np.asarray(raw, dtype=float)
-    return {"sample_rate": float(sample_rate), "noise_std": quiet_noise(raw, sample_rate).tolist(),
+    return {"sample_rate": float(sample_rate), "quiet_noise_std": quiet_noise(raw, sample_rate).tolist(),
             "max_abs_rate": np.max(np.abs(raw), axis=0).tolist(), "units": units}
 
 
 def _ratio(observed, raw: np.ndarray, sample_rate: float) -> tuple[float, np.ndarray, np.ndarray]:
     """Median over axes of the noise ratio (data / calibration), and both noise levels."""
-    then = np.asarray(observed["noise_std"], dtype=float)
+    # the calibration's quiet noise, measured as here; else the noise behind its 1-sigma
+    then = np.asarray(observed.get("quiet_noise_std") or observed["noise_std"], dtype=float)
     now = quiet_noise(raw, sample_rate)
     ok = (then > 0) & (now > 0)  # quantised quiet data can read zero: no evidence
     return (float(np.median(now[ok] / then[ok])) if ok.any() else math.nan), now, then
@@ -78,8 +79,8 @@ def check_observed(observed, raw: np.ndarray, sample_rate: float, *, source: str
     Parameters
     ----------
     observed : mapping
-        The calibration's ``observed`` section: ``noise_std`` and ``max_abs_rate`` per axis in
-        ``units`` (the calibration's input unit).
+        The calibration's ``observed`` section: ``quiet_noise_std`` (else ``noise_std``) and
+        ``max_abs_rate`` per axis in ``units`` (the calibration's input unit).
     raw : array_like, shape (N, 3)
         The data to correct, as read in the calibration's input unit.
     sample_rate : float

@@ -70,34 +70,45 @@ static gyrocal_status_t solve(float *a, float *b, int n, int nrhs)
     return GYROCAL_OK;
 }
 
-void gyrocal_correct(const gyrocal_affine_t *cal, const float raw[3], float out[3])
+gyrocal_status_t gyrocal_correct(const gyrocal_affine_t *cal, const float raw[3], float out[3])
 {
     float d[3];
     int i;
+    if (cal == 0 || raw == 0 || out == 0) {
+        return GYROCAL_E_INPUT;
+    }
     for (i = 0; i < 3; ++i) {
         d[i] = raw[i] - cal->offset[i];
     }
     for (i = 0; i < 3; ++i) {
         out[i] = cal->matrix[i][0] * d[0] + cal->matrix[i][1] * d[1] + cal->matrix[i][2] * d[2];
     }
+    return GYROCAL_OK;
 }
 
-void gyrocal_scale_bias_to_affine(const gyrocal_scale_bias_t *sb, gyrocal_affine_t *out)
+gyrocal_status_t gyrocal_scale_bias_to_affine(const gyrocal_scale_bias_t *sb, gyrocal_affine_t *out)
 {
     int i, j;
+    if (sb == 0 || out == 0 || !finite3(sb->k) || !finite3(sb->b)) {
+        return GYROCAL_E_INPUT;
+    }
     for (i = 0; i < 3; ++i) {
         for (j = 0; j < 3; ++j) {
             out->matrix[i][j] = (i == j) ? sb->k[i] : 0.0f;
         }
         out->offset[i] = -sb->b[i];
     }
+    return GYROCAL_OK;
 }
 
-/* Position in K (seed 001, eq. 11) of the Kg elements 0..8 (eq. 14), as row * 3 + column. */
+/* Position in K (the full-temperature-range method, eq. 11) of the Kg elements 0..8 (eq. 14), as row * 3 + column. */
 static const uint8_t KG_SLOT[9] = {0, 4, 8, 1, 2, 3, 5, 6, 7};
 
 float gyrocal_temp_filter(float *state, float temp, float alpha)
 {
+    if (state == 0) {
+        return temp;
+    }
     *state += alpha * (temp - *state);
     return *state;
 }
@@ -108,11 +119,18 @@ gyrocal_status_t gyrocal_thermal_correct(const gyrocal_thermal_t *table, float t
     float k[9], d[3], w[3];
     const float *t;
     int n, i, s, e;
-    if (table == 0 || table->n < 3 || !isfinite(temp) || !finite3(raw) || (flags & ~GYROCAL_THERMAL_CLAMP)) {
+    if (table == 0 || table->temps == 0 || table->kg == 0 || raw == 0 || out == 0 || table->n < 3 ||
+        !isfinite(temp) || !finite3(raw) || (flags & ~GYROCAL_THERMAL_CLAMP)) {
         return GYROCAL_E_INPUT;
     }
     n = table->n;
     t = table->temps;
+    /* a malformed table (repeated, decreasing or non-finite nodes) would divide by zero below */
+    for (i = 0; i < n; ++i) {
+        if (!isfinite(t[i]) || (i > 0 && !(t[i] > t[i - 1]))) {
+            return GYROCAL_E_INPUT;
+        }
+    }
     if (temp < t[0] || temp > t[n - 1]) {
         if (!(flags & GYROCAL_THERMAL_CLAMP) && (temp < t[0] - GYROCAL_THERMAL_MARGIN ||
                                                   temp > t[n - 1] + GYROCAL_THERMAL_MARGIN)) {
@@ -125,12 +143,12 @@ gyrocal_status_t gyrocal_thermal_correct(const gyrocal_thermal_t *table, float t
     s = i - 2;
     s = s < 0 ? 0 : (s > n - 3 ? n - 3 : s);
     t += s;
-    /* seed 001, eq. 22: the three Lagrange basis values at temp */
+    /* the full-temperature-range method, eq. 22: the three Lagrange basis values at temp */
     w[0] = (temp - t[1]) * (temp - t[2]) / ((t[0] - t[1]) * (t[0] - t[2]));
     w[1] = (temp - t[2]) * (temp - t[0]) / ((t[1] - t[2]) * (t[1] - t[0]));
     w[2] = (temp - t[0]) * (temp - t[1]) / ((t[2] - t[0]) * (t[2] - t[1]));
     for (e = 0; e < 12; ++e) {
-        /* seed 001, eq. 21 */
+        /* the full-temperature-range method, eq. 21 */
         float v = w[0] * table->kg[s][e] + w[1] * table->kg[s + 1][e] + w[2] * table->kg[s + 2][e];
         if (e < 9) {
             k[KG_SLOT[e]] = v;
@@ -150,6 +168,9 @@ gyrocal_status_t gyrocal_thermal_correct(const gyrocal_thermal_t *table, float t
 
 void gyrocal_accum_reset(gyrocal_accum_t *acc)
 {
+    if (acc == 0) {
+        return;
+    }
     acc->count = 0u; /* the sums are cleared by the next sample, see gyrocal_accum_add */
 }
 
@@ -168,6 +189,9 @@ static void comp_add(float *sum, float *comp, float x)
 void gyrocal_accum_add(gyrocal_accum_t *acc, const float sample[3])
 {
     int i;
+    if (acc == 0 || sample == 0) {
+        return;
+    }
     if (acc->count == 0u) {
         /* Cleared here rather than in reset: a zeroing loop would compile to a call to memset. */
         for (i = 0; i < 3; ++i) {
@@ -187,8 +211,12 @@ void gyrocal_accum_add(gyrocal_accum_t *acc, const float sample[3])
 gyrocal_status_t gyrocal_accum_finish(const gyrocal_accum_t *acc, float rate, gyrocal_obs_t *obs)
 {
     float mean[3], mean_sq[3];
-    float n = (float)acc->count; /* exact up to 2^24 samples */
+    float n;
     int i;
+    if (acc == 0 || obs == 0) {
+        return GYROCAL_E_INPUT;
+    }
+    n = (float)acc->count; /* exact up to 2^24 samples */
     if (acc->count < 2u || !isfinite(rate) || rate < 0.0f) {
         return GYROCAL_E_INPUT;
     }
@@ -209,7 +237,7 @@ gyrocal_status_t gyrocal_accum_finish(const gyrocal_accum_t *acc, float rate, gy
     return GYROCAL_OK;
 }
 
-/* beta0 implied by beta (seed 000, eq. 3): sum beta_{j+3}^2 / (4 beta_j). */
+/* beta0 implied by beta (the servo method of Wang et al., eq. 3): sum beta_{j+3}^2 / (4 beta_j). */
 static float gamma_of(const float beta[N6])
 {
     return beta[3] * beta[3] / (4.0f * beta[0]) + beta[4] * beta[4] / (4.0f * beta[1])
@@ -221,7 +249,7 @@ static int k2_positive(const float beta[N6])
     return beta[0] > 0.0f && beta[1] > 0.0f && beta[2] > 0.0f;
 }
 
-/* Solve X u = Y and X v = 1 for the six-observation design (seed 000, eq. 6-7), with the
+/* Solve X u = Y and X v = 1 for the six-observation design (the servo method of Wang et al., eq. 6-7), with the
  * regressors (mean of squares, or squared mean, then mean) and Y = rate^2, all divided by
  * the largest rate r (or r^2) so that the pivot test and the stop rule do not depend on units. */
 static gyrocal_status_t six_solve(const gyrocal_obs_t obs[N6], int squared_mean, float u[N6], float v[N6],
@@ -259,7 +287,7 @@ static gyrocal_status_t six_solve(const gyrocal_obs_t obs[N6], int squared_mean,
     return GYROCAL_OK;
 }
 
-/* Seed 000's return step: k = sqrt(beta_1..3), b = beta_4..6 / (2 beta_1..3), undoing the rate scaling. */
+/* The servo method's return step: k = sqrt(beta_1..3), b = beta_4..6 / (2 beta_1..3), undoing the rate scaling. */
 static gyrocal_status_t finish_kb(const float beta[N6], float r, gyrocal_scale_bias_t *out)
 {
     float k[3], b[3];
@@ -286,14 +314,14 @@ gyrocal_status_t gyrocal_algorithm1(const gyrocal_obs_t obs[GYROCAL_N_OBS], gyro
 {
     float u[N6], v[N6], beta[N6], r;
     int it, j;
-    gyrocal_status_t st = six_solve(obs, 0, u, v, &r);
+    gyrocal_status_t st = (obs == 0 || out == 0) ? GYROCAL_E_INPUT : six_solve(obs, 0, u, v, &r);
     if (st != GYROCAL_OK) {
         return st;
     }
     for (j = 0; j < N6; ++j) {
         beta[j] = u[j]; /* beta0 = 0: the initial estimate */
     }
-    /* beta(n+1) = X^-1 (Y - gamma(beta(n))) = u - gamma v, seed 000 Algorithm 1 */
+    /* beta(n+1) = X^-1 (Y - gamma(beta(n))) = u - gamma v, the servo method of Wang et al., Algorithm 1 */
     for (it = 1; it <= GYROCAL_MAX_ITER; ++it) {
         float g, delta = 0.0f, size = 0.0f;
         if (!k2_positive(beta)) {
@@ -324,7 +352,7 @@ gyrocal_status_t gyrocal_first_moment(const gyrocal_obs_t obs[GYROCAL_N_OBS], gy
 {
     float u[N6], v[N6], beta[N6], r, b0 = 0.0f, vsum = 0.0f;
     int it, j;
-    gyrocal_status_t st = six_solve(obs, 1, u, v, &r);
+    gyrocal_status_t st = (obs == 0 || out == 0) ? GYROCAL_E_INPUT : six_solve(obs, 1, u, v, &r);
     if (st != GYROCAL_OK) {
         return st;
     }

@@ -9,11 +9,15 @@
  *     w_true = matrix * (raw - offset)
  *
  * raw and offset in the sensor's units, matrix maps them to the output units.
- * Seed 000 (eq. 1) writes g = diag(k) (m + b): matrix = diag(k), offset = -b.
- * Seed 001 (eq. 12) writes w = K w~ + B: matrix = K^-1, offset = B.
+ * The servo method of Wang et al. (eq. 1) writes g = diag(k) (m + b): matrix = diag(k), offset = -b.
+ * The full-temperature-range method (eq. 12) writes w = K w~ + B: matrix = K^-1, offset = B.
  *
- * Every function that can fail returns a gyrocal_status_t; on failure the
- * outputs are left untouched, so a caller never sees NaN parameters.
+ * Every function that can fail returns a gyrocal_status_t. On failure the outputs are left
+ * untouched, so a caller never sees NaN parameters; the one exception is the iteration count of
+ * the solvers, which is written on GYROCAL_E_NOCONV too (how far they went). A NULL pointer
+ * argument, a NaN or infinite input, or a malformed table (fewer than 3 nodes, nodes not strictly
+ * increasing or not finite) gives GYROCAL_E_INPUT. Functions without a status (the accumulator,
+ * the temperature filter) do nothing with a NULL pointer.
  */
 #ifndef GYROCAL_CAL_H
 #define GYROCAL_CAL_H
@@ -38,14 +42,14 @@ typedef enum {
     GYROCAL_E_RANGE = 5        /* temperature outside the table and GYROCAL_THERMAL_CLAMP not given */
 } gyrocal_status_t;
 
-/* Six observations: the G-optimal design of seed 000 (+x, -x, +y, -y, +z, -z turns). */
+/* Six observations: the G-optimal design of the servo method of Wang et al. (+x, -x, +y, -y, +z, -z turns). */
 #define GYROCAL_N_OBS 6
 /* Relative pivot threshold of the 6x6 and 3x3 eliminations (on rate-normalised entries). */
 #ifndef GYROCAL_PIVOT_RTOL
 #define GYROCAL_PIVOT_RTOL 1e-5f
 #endif
 /* Stop when sum|delta beta| <= GYROCAL_REL_TOL * sum|beta| (beta normalised by the largest rate):
- * 16 float32 epsilons, the float32 stand-in for seed 000's absolute 1e-6. */
+ * 16 float32 epsilons, the float32 stand-in for the servo method's absolute 1e-6. */
 #ifndef GYROCAL_REL_TOL
 #define GYROCAL_REL_TOL 1.9073486e-06f
 #endif
@@ -59,13 +63,13 @@ typedef struct {
     float offset[3];
 } gyrocal_affine_t;
 
-/* Seed 000 parameters: g = diag(k) (m + b); b in the sensor's units, added to the reading. */
+/* Parameters of the servo method of Wang et al.: g = diag(k) (m + b); b in the sensor's units, added to the reading. */
 typedef struct {
     float k[3];
     float b[3];
 } gyrocal_scale_bias_t;
 
-/* Seed 001 temperature table: n >= 3 strictly increasing nodes [degC] and one Kg 12-vector per
+/* Temperature table of the full-temperature-range method: n >= 3 strictly increasing nodes [degC] and one Kg 12-vector per
  * node, eq. 14 order [Kxx,Kyy,Kzz,Kyx,Kzx,Kxy,Kzy,Kxz,Kyz,Bx,By,Bz]; K maps output units to
  * sensor units, B is in sensor units. */
 typedef struct {
@@ -96,13 +100,14 @@ typedef struct {
     float rate;
 } gyrocal_obs_t;
 
-/* w = matrix (raw - offset). */
-void gyrocal_correct(const gyrocal_affine_t *cal, const float raw[3], float out[3]);
+/* w = matrix (raw - offset); out may be raw. NaN readings give NaN rates (checking each sample
+ * would cost more than the correction). */
+gyrocal_status_t gyrocal_correct(const gyrocal_affine_t *cal, const float raw[3], float out[3]);
 
-/* The canonical form of seed 000 parameters: matrix = diag(k), offset = -b. */
-void gyrocal_scale_bias_to_affine(const gyrocal_scale_bias_t *sb, gyrocal_affine_t *out);
+/* The canonical form of the servo method's parameters (Wang et al.): matrix = diag(k), offset = -b. */
+gyrocal_status_t gyrocal_scale_bias_to_affine(const gyrocal_scale_bias_t *sb, gyrocal_affine_t *out);
 
-/* w = K(T)^-1 (raw - B(T)), Kg(T) by 3-node Lagrange interpolation (seed 001, eq. 21-22) over nodes
+/* w = K(T)^-1 (raw - B(T)), Kg(T) by 3-node Lagrange interpolation (the full-temperature-range method, eq. 21-22) over nodes
  * s, s+1, s+2 with s = clamp(i - 2, 0, n - 3) and i the first node >= T. */
 gyrocal_status_t gyrocal_thermal_correct(const gyrocal_thermal_t *table, float temp, const float raw[3],
                                          unsigned flags, float out[3]);
@@ -110,15 +115,17 @@ gyrocal_status_t gyrocal_thermal_correct(const gyrocal_thermal_t *table, float t
 /* One step of a first-order low-pass of the temperature reading [degC] before gyrocal_thermal_correct,
  * so that readings in whole degrees do not make the corrected output jump. alpha = 1 - expf(-dt / tau)
  * for sample interval dt and time constant tau (GYROCAL_THERMAL_TEMP_TAU_S in exported headers);
- * set *state to the first reading before the first call. Returns the filtered temperature. */
+ * set *state to the first reading before the first call. Returns the filtered temperature (temp itself
+ * when state is NULL). */
 float gyrocal_temp_filter(float *state, float temp, float alpha);
 
 void gyrocal_accum_reset(gyrocal_accum_t *acc);
 void gyrocal_accum_add(gyrocal_accum_t *acc, const float sample[3]);
-/* Window mean and mean of squares; `rate` is stored as the observation's reference. */
+/* Window mean and mean of squares; `rate` is stored as the observation's reference. A window with a
+ * NaN or infinite sample gives GYROCAL_E_INPUT here. */
 gyrocal_status_t gyrocal_accum_finish(const gyrocal_accum_t *acc, float rate, gyrocal_obs_t *obs);
 
-/* Seed 000 Algorithm 1 on exactly six observations (regressors: means of squares and means). */
+/* The servo method of Wang et al., Algorithm 1 on exactly six observations (regressors: means of squares and means). */
 gyrocal_status_t gyrocal_algorithm1(const gyrocal_obs_t obs[GYROCAL_N_OBS], gyrocal_scale_bias_t *out,
                                     int *iterations);
 

@@ -60,11 +60,11 @@ typedef struct {
     float sensitivity;  /* counts per rate unit (LSB per deg/s for deg/s) */
     uint8_t rate_unit;  /* GYROCAL_UNIT_* */
     uint8_t flags;      /* GYROCAL_HELLO_* */
-    uint16_t library;   /* gyrocal C library version, major << 8 | minor */
+    uint16_t library;   /* GYROCAL_CAL_VERSION of the gyrocal C library the firmware was built with */
     char firmware[16];  /* firmware name and version, NUL-padded (need not be terminated) */
 } gyrocal_hello_t;
 
-/* Slots of the six turns, in seed 000's order (+x, -x, +y, -y, +z, -z). */
+/* Slots of the six turns, in the servo method's order (+x, -x, +y, -y, +z, -z). */
 typedef struct {
     uint32_t start;     /* first sample (the sample frames' seq) */
     uint32_t stop;      /* one past the last sample */

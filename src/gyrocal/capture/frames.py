@@ -42,7 +42,7 @@ OVERHEAD = 6  # sync (2), type, length, CRC (2)
 MAX_PAYLOAD = 64
 PROTOCOL = 1
 TEMP_NONE = -32768  # temperature field of a device without a thermometer
-#: Slots of the six turns (seed 000's order): slot i is TURN_LABELS[i].
+#: Slots of the six turns (the servo method's order): slot i is TURN_LABELS[i].
 TURN_LABELS = ("+x", "-x", "+y", "-y", "+z", "-z")
 _UNITS = ("rad/s", "deg/s")
 _METHODS = ("first-moment", "algorithm1")
@@ -72,7 +72,7 @@ class Hello:
     sensitivity: float
     rate_unit: str = "deg/s"
     has_temp: bool = False
-    library: int = 0x0100
+    library: int = 2  # GYROCAL_CAL_VERSION
     firmware: str = ""
     protocol: int = PROTOCOL
 

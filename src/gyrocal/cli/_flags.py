@@ -58,6 +58,15 @@ FLAGS: dict[str, str] = {
     "quantum": "--quantum",
     "bias_instability": "--bias-instability",
     "rate_random_walk": "--rrw",
+    # capture, simulate --device
+    "port": "--port",
+    "baud": "--baud",
+    "wire": "--wire",
+    "samples": "--samples",
+    "silence": "--silence",
+    "guide": "--guide",
+    "faults": "--faults",
+    "pace": "--pace",
 }
 
 #: Parameters that library errors name but that no flag sets (the command line fills them itself).

@@ -12,9 +12,9 @@ from typing import Annotated, Optional
 
 import typer
 
-from ..choices import Protocol
+from ..choices import DeviceWire, Protocol
 from ..errors import InputError
-from ._options import NoiseDensity, noise_std, numbers, refuse_unused, triple
+from ._options import NoiseDensity, given, noise_std, numbers, refuse_unused, triple
 from ._outputs import check_output, json_format, starts_with
 from .app import app, console
 
@@ -50,8 +50,8 @@ def _turntable_protocol(temps: str | None, rates: str | None, step_duration: flo
 @app.command()
 def simulate(
     ctx: typer.Context,
-    output: Annotated[Path, typer.Option(
-        "-o", "--output", help="Recording to write (CSV); the truth goes to *.truth.json.")],
+    output: Annotated[Path | None, typer.Option(
+        "-o", "--output", help="Recording to write (CSV); the truth goes to *.truth.json (required, except with --device).")] = None,
     protocol: Annotated[Protocol, typer.Option("--protocol", help="Motion source.")] = "servo",
     speed: Annotated[float, typer.Option("--speed", help="Servo/hand turn speed [deg/s].")] = 60.0,
     turns: Annotated[str, typer.Option("--turns", help="Turns, comma-separated.")] = "+x,-x,+y,-y,+z,-z",
@@ -91,6 +91,16 @@ def simulate(
     seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
     force: Annotated[bool, typer.Option("--force", help="Replace an -o file that gyrocal simulate did not write.")]
     = False,
+    device: Annotated[bool, typer.Option(
+        "--device", help="Serve a servo or hand session on a pseudo-terminal as a board would, for 'gyrocal "
+                         "capture --port ...' (raw counts at 131 LSB per deg/s; frames are the example firmware's: "
+                         "samples, its own six-turn calibration, corrected samples).")] = False,
+    wire: Annotated[DeviceWire, typer.Option("--wire", help="--device: gyrocal frames or text lines.")] = "frames",
+    faults: Annotated[str | None, typer.Option(
+        "--faults", help="--device: drop=P,corrupt=P (per byte),stall=AT:SECONDS,disconnect=AT (AT: fraction of "
+                         "the stream) (default: none).")] = None,
+    pace: Annotated[float, typer.Option(
+        "--pace", help="--device: 1 = real time, 10 = ten times faster, 0 = as fast as the reader reads.")] = 1.0,
 ) -> None:
     """Simulate a recording (servo, hand, turntable or profile) with its truth sidecar."""
     import numpy as np
@@ -103,6 +113,14 @@ def simulate(
     from ..units import parse_rate_unit
 
     refuse_unused(ctx, _PROTOCOL_FLAGS, protocol, "--protocol")
+    if device:
+        return _serve_device(protocol, speed, turns, wait, misalignment, k, b, noise, noise_density, sample_rate,
+                             seed, wire, faults, pace)
+    for name in ("wire", "faults", "pace"):
+        if given(ctx, name):
+            raise InputError(f"--{name} is for --device only; add --device or leave --{name} out")
+    if output is None:
+        raise InputError("give -o FILE.csv for the recording (or --device to serve a session on a pseudo-terminal)")
     truth_file = truth_path(output)
     check_output(output, inputs=(profile,), force=force, replaceable=starts_with(f"# {_SIMULATED}"))
     check_output(truth_file, flag="truth file", inputs=(profile,), force=force,
@@ -157,3 +175,38 @@ def simulate(
                     header_comment=f"{_SIMULATED} --protocol {protocol}; gyro in {unit}, t in s")
     save(SimulationTruth(protocol=protocol, model=model, settings=settings, facts=facts), truth_file)
     console.print(f"wrote {output} ({len(rec)} samples, {len(rec) / sample_rate:.1f} s, {unit}) and {truth_file}")
+
+
+def _serve_device(protocol, speed, turns, wait, misalignment, k, b, noise, noise_density, sample_rate, seed, wire,
+                  faults, pace) -> None:
+    """``simulate --device``: a simulated session served on a pseudo-terminal until it is read to the end."""
+    import numpy as np
+
+    from ..capture.device import VirtualDevice, damage, device_bytes, parse_faults
+    from ..capture.simulated import simulate_device_session
+    from ..models import ScaleBias
+    from ..simulation.servo import ServoProtocol
+
+    if protocol not in _SERVO:
+        raise InputError(f"--device serves servo or hand sessions, got --protocol {protocol}")
+    if not pace >= 0:
+        raise InputError(f"--pace must be >= 0, got {pace!r}")
+    fault = parse_faults(faults, seed)
+    turn_list = tuple(t.strip() for t in turns.split(",") if t.strip())
+    kw = dict(speed=math.radians(speed), wait=wait, misalignment_deg=misalignment, lead_in=3.0)
+    proto = ServoProtocol.hand(turn_list, **kw) if protocol == "hand" else ServoProtocol(turns=turn_list, **kw)
+    sd = noise_std(noise, noise_density, sample_rate, 0.01)
+    model = ScaleBias(triple("--k", k, (1.0, 1.0, 1.0)), triple("--b", b, (0.0, 0.0, 0.0)))
+    session = simulate_device_session(proto, model=model, noise_std=sd, rng=np.random.default_rng(seed),
+                                      sample_rate=sample_rate)
+    data, _ = damage(device_bytes(session, wire), fault)
+    rate = None if pace == 0 else len(data) / (len(session) / sample_rate) * pace
+    with VirtualDevice(data, faults=fault, byte_rate=rate, wait_for="reader") as dev:
+        port = dev.start()
+        console.print(f"virtual device on {port}: {protocol} session, {len(session)} samples "
+                      f"({len(session) / sample_rate:.0f} s at {sample_rate:g} Hz), {wire}; it starts when a reader "
+                      f"opens the port, e.g.\n  gyrocal capture --port {port} -o rec.csv --guide {protocol}",
+                      highlight=False, soft_wrap=True, markup=False)
+        while not dev.wait(1.0):
+            pass
+    console.print(f"sent {dev.sent:,} bytes; the device closed the link", highlight=False)

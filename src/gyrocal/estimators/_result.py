@@ -26,7 +26,7 @@ class BatchFit:
     Attributes
     ----------
     k, b : ndarray, shape (B, 3)
-        Seed 000 scale factors and biases [b in reading units].
+        Scale factors and biases of the servo method of Wang et al. [b in reading units].
     iterations : ndarray of int, shape (B,)
     converged : ndarray of bool, shape (B,)
     residuals : ndarray, shape (B, m)

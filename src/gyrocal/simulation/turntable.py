@@ -1,4 +1,4 @@
-"""A single-axis, temperature-controlled turntable running seed 001's protocol.
+"""A single-axis, temperature-controlled turntable running the full-temperature-range method's protocol.
 
 At every temperature of Table 1 (after the soak, which is not recorded) the gyro is
 mounted with x, y, then z up along the table axis, and the table runs each rate of
@@ -21,9 +21,9 @@ from .gyro import VirtualGyro
 
 __all__ = ["TABLE1_TEMPS", "TABLE2_RATES", "TurntableProtocol", "simulate_turntable"]
 
-#: Seed 001 Table 1 [degC].
+#: The full-temperature-range method, Table 1 [degC].
 TABLE1_TEMPS: tuple[float, ...] = (-40.0, -30.0, -20.0, -10.0, 0.0, 10.0, 20.0, 30.0, 40.0, 50.0)
-#: Seed 001 Table 2 [deg/s], each non-zero rate run forward and reverse.
+#: The full-temperature-range method, Table 2 [deg/s], each non-zero rate run forward and reverse.
 TABLE2_RATES: tuple[float, ...] = (0.0, 0.1, 1.0, 10.0, 50.0, 100.0, 150.0, 200.0, 250.0, 300.0, 400.0)
 
 

@@ -1,7 +1,7 @@
-"""Per-sample simulation of seed 000's six-observation protocol, reduced to windows.
+"""Per-sample simulation of the servo method's six-observation protocol, reduced to windows.
 
 This is the reference generator: it draws every sample, then reduces each window
-exactly as :func:`gyrocal.observe` would. It follows seed 000, section III-A:
+exactly as :func:`gyrocal.observe` would. It follows the servo method of Wang et al., section III-A:
 
 * readings ``m = g / k - b + noise`` (eq. 1 solved for ``m``), white Gaussian noise;
 * one full revolution per axis and sense (Fig. 1) at ``speed``, ``n = round(2 pi / speed * fs)``
@@ -24,24 +24,13 @@ import numpy as np
 from .._validation import finite_array, positive
 from ..errors import InputError
 from ..observations import ObservationSet
+from ..windows import axis_vector
 
 __all__ = ["PAPER_AXES", "axis_vector", "paper_observations"]
 
 #: The paper's Fig. 1 order: +-x, +-y, +-z.
 PAPER_AXES: tuple[str, ...] = ("+x", "-x", "+y", "-y", "+z", "-z")
 _CHUNK_SAMPLES = 2_000_000  # samples x batch items drawn at once (~50 MB of float64 per array)
-
-
-def axis_vector(name: str) -> np.ndarray:
-    """Unit vector of a signed axis name such as ``"+x"`` or ``"-z"``."""
-    key = str(name).strip().lower()
-    if len(key) == 1:
-        key = "+" + key
-    if len(key) != 2 or key[0] not in "+-" or key[1] not in "xyz":
-        raise InputError(f"axis {name!r} is not one of +x, -x, +y, -y, +z, -z")
-    e = np.zeros(3)
-    e["xyz".index(key[1])] = 1.0 if key[0] == "+" else -1.0
-    return e
 
 
 def _tilted_axes(e: np.ndarray, misalignment: float, size: int, rng: np.random.Generator) -> np.ndarray:
@@ -99,7 +88,7 @@ def paper_observations(
     Parameters
     ----------
     k, b : array_like, shape (B, 3) or (3,)
-        True scale factors [-] and biases [rad/s] (seed 000 eq. 1).
+        True scale factors [-] and biases [rad/s] (the servo method of Wang et al., eq. 1).
     speed : float
         Servo speed [rad/s] (the paper: 60 deg/s = pi/3).
     sample_rate : float

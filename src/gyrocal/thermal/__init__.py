@@ -1,4 +1,4 @@
-"""Full-temperature-range calibration (seed 001), end to end.
+"""Full-temperature-range calibration (the full-temperature-range method), end to end.
 
 Turntable recordings -> steps (:mod:`.session`) -> per-temperature 12-parameter
 least squares (:mod:`.fit`) -> a temperature table with 3-node Lagrange

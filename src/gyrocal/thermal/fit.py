@@ -1,4 +1,4 @@
-"""Per-temperature 12-parameter least squares (seed 001, eq. 13-19).
+"""Per-temperature 12-parameter least squares (the full-temperature-range method, eq. 13-19).
 
 Eq. 13 stacks ``w = Kg Omega`` for every step. Because each gyro axis has its own
 four unknowns (one row of K and one bias), the 12-parameter problem splits exactly
@@ -86,7 +86,7 @@ def fit_point(reference, means, noise_var, count) -> PointFit:
         raise DegenerateDesignError(f"{len(ref)} steps cannot determine K and B at this temperature; each of x, y, z "
                                     "needs a non-zero table rate along it")
     inv = np.linalg.inv(XtX)
-    beta = inv @ (X.T @ np.asarray(means, float))  # (4, 3), seed 001 eq. 19 per axis
+    beta = inv @ (X.T @ np.asarray(means, float))  # (4, 3), the full-temperature-range method, eq. 19 per axis
     resid = means - X @ beta
     dof = max(len(ref) - 4, 1)
     s2 = (resid ** 2).sum(axis=0) / dof  # (3,)

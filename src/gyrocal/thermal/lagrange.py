@@ -1,4 +1,4 @@
-"""Three-node Lagrange interpolation in temperature (seed 001, eq. 21-22).
+"""Three-node Lagrange interpolation in temperature (the full-temperature-range method, eq. 21-22).
 
 The stencil rule is fixed, because the firmware export implements the same in C:
 with nodes ``T_0 < ... < T_{n-1}`` and ``i`` the first node ``>= T``, the stencil
@@ -81,7 +81,7 @@ def lagrange_weights(nodes, temp, out_of_range: OutOfRange = "refuse") -> tuple[
     index : ndarray of int, shape (N, 3)
         Node indices ``s, s+1, s+2``.
     weight : ndarray, shape (N, 3)
-        Lagrange basis values at `temp` (seed 001, eq. 22); they sum to 1.
+        Lagrange basis values at `temp` (the full-temperature-range method, eq. 22); they sum to 1.
     """
     t = check_nodes(nodes)
     x = range_policy(t, finite_array("temp", temp, ndim=1), out_of_range)
@@ -89,14 +89,14 @@ def lagrange_weights(nodes, temp, out_of_range: OutOfRange = "refuse") -> tuple[
     idx = s[:, None] + np.arange(3)
     tn = t[idx]
     w = np.empty_like(tn)
-    for j in range(3):  # seed 001, eq. 22
+    for j in range(3):  # the full-temperature-range method, eq. 22
         a, b = tn[:, (j + 1) % 3], tn[:, (j + 2) % 3]
         w[:, j] = (x - a) * (x - b) / ((tn[:, j] - a) * (tn[:, j] - b))
     return idx, w
 
 
 def interpolate(nodes, values, temp, out_of_range: OutOfRange = "refuse") -> np.ndarray:
-    """Interpolate node values (n, ...) at temperatures (N,) [degC]; returns (N, ...) (seed 001, eq. 21)."""
+    """Interpolate node values (n, ...) at temperatures (N,) [degC]; returns (N, ...) (the full-temperature-range method, eq. 21)."""
     v = np.asarray(values, dtype=float)
     idx, w = lagrange_weights(nodes, np.atleast_1d(np.asarray(temp, dtype=float)), out_of_range)
     if v.shape[0] != len(np.asarray(nodes)):

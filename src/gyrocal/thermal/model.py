@@ -40,8 +40,8 @@ from ..choices import OutOfRange, TableModel, values
 from ..errors import FileFormatError, InputError, UnitError
 from ..files import register
 from ..models import KG_NAMES, kg_to_kb
-from ..sections import FitQuality, section
 from ..recording import Recording
+from ..sections import FitQuality, section
 from ..units import RateUnit, parse_rate_unit, unit_factor
 from .lagrange import check_nodes, interpolate, range_policy
 from .smooth import SmoothModel
@@ -57,7 +57,7 @@ RULE = ("3-node Lagrange (the full-temperature-range method, eq. 21-22): i = fir
 @register
 @dataclass(frozen=True)
 class ThermalCalibration:
-    """A gyro calibrated at several temperatures (seed 001).
+    """A gyro calibrated at several temperatures (the full-temperature-range method).
 
     Parameters
     ----------
