@@ -14,6 +14,7 @@ FLAGS: dict[str, str] = {
     # reading
     "units": "--units",
     "columns": "--columns",
+    "skip_rows": "--skip-rows",
     "sample_rate": "--sample-rate",
     "sensitivity": "--sensitivity",
     "output_units": "--output-units",

@@ -27,25 +27,25 @@ def export(
         "--prefix", help="c-header: start of every C name (default gyrocal), so one firmware can hold several "
                          "sensors' calibrations.")] = None,
     rostopic: Annotated[Optional[str], typer.Option(
-        "--rostopic", help="kalibr: the IMU's ROS topic (default /imu0).")] = None,
+        "--rostopic", help="kalibr: the IMU's ROS topic (default: /imu0).")] = None,
     update_rate: Annotated[Optional[float], typer.Option(
         "--update-rate", help="kalibr, vins: IMU rate [Hz] of the target log (default: the noise log's).")] = None,
     inflate: Annotated[Optional[float], typer.Option(
         "--inflate", help="kalibr, vins, imu_utils: safety factor on every noise value, recorded in the file "
-                          "(default 1).")] = None,
+                          "(default: 1).")] = None,
     accel_noise_density: Annotated[Optional[float], typer.Option(
         "--accel-noise-density", help="kalibr, vins: accelerometer density [m/s^2/sqrt(Hz)] when the noise file "
-                                      "has none.")] = None,
+                                      "has none (default: none, from the file).")] = None,
     accel_random_walk: Annotated[Optional[float], typer.Option(
         "--accel-random-walk", help="kalibr, vins: accelerometer bias random walk [m/s^3/sqrt(Hz)] when the noise "
-                                    "file has none.")] = None,
+                                    "file has none (default: none, from the file).")] = None,
     gyro_random_walk: Annotated[Optional[float], typer.Option(
         "--gyro-random-walk", help="kalibr, vins: gyro bias random walk [rad/s^2/sqrt(Hz)] when the log is too "
-                                   "short to see it.")] = None,
+                                   "short to see it (default: none, from the file).")] = None,
     random_walk_bound: Annotated[bool, typer.Option(
         "--random-walk-bound", help="kalibr, vins: where a random walk is not seen, use its 95 % upper bound.")]
     = False,
-    name: Annotated[Optional[str], typer.Option("--name", help="imu_utils: the IMU's name (default imu).")] = None,
+    name: Annotated[Optional[str], typer.Option("--name", help="imu_utils: the IMU's name (default: imu).")] = None,
     slot: Annotated[Optional[int], typer.Option(
         "--slot", help="px4: TC_G slot 0-3; ardupilot: INS_TCAL set 1-3 (default: the log's IMU).")] = None,
     device_id: Annotated[Optional[int], typer.Option(

@@ -48,8 +48,8 @@ def _summary(tb, unit: str, factor: float):
 @app.command("thermal-bias")
 def thermal_bias(
     log: Annotated[Path, typer.Argument(help="Still log of a warming board: PX4 .ulg, ArduPilot .bin, CSV, ...")],
-    output: Annotated[Optional[Path], typer.Option("-o", "--output", help="Thermal-bias file to write (JSON).")]
-    = None,
+    output: Annotated[Optional[Path], typer.Option(
+        "-o", "--output", help="Thermal-bias file to write, JSON (default: none, print only).")] = None,
     units: READING.Units = None,
     columns: READING.Columns = None,
     sample_rate: READING.SampleRate = None,

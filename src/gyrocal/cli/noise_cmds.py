@@ -70,8 +70,10 @@ def noise(
     imu: READING.Imu = None,
     motion: Annotated[MotionPolicy, typer.Option(
         "--motion", help="A log that moves: analyse its longest still stretch (restrict) or refuse it.")] = "restrict",
-    plot: Annotated[Optional[Path], typer.Option("--plot", help="Allan deviation plot (.png, .pdf, .svg).")] = None,
-    json_out: Annotated[Optional[Path], typer.Option("--json", help="Write the noise file (gyrocal.noise).")] = None,
+    plot: Annotated[Optional[Path], typer.Option(
+        "--plot", help="Allan deviation plot (.png, .pdf, .svg) (default: none).")] = None,
+    json_out: Annotated[Optional[Path], typer.Option(
+        "--json", help="Write the noise file, gyrocal.noise (default: none).")] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace a --json file that is not a noise file.")]
     = False,
 ) -> None:

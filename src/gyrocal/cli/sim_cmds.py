@@ -83,7 +83,7 @@ def _turntable_protocol(temps: str | None, rates: str | None, step_duration: flo
 def simulate(
     ctx: typer.Context,
     output: Annotated[Path | None, typer.Option(
-        "-o", "--output", help="Recording to write (CSV); the truth goes to *.truth.json.")] = None,
+        "-o", "--output", help="Recording to write (CSV); the truth goes to *.truth.json (required, except with --device).")] = None,
     protocol: Annotated[Protocol, typer.Option("--protocol", help="Motion source.")] = "servo",
     speed: Annotated[float, typer.Option("--speed", help="Servo/hand turn speed [deg/s].")] = 60.0,
     turns: Annotated[str, typer.Option("--turns", help="Turns, comma-separated.")] = "+x,-x,+y,-y,+z,-z",
@@ -92,19 +92,19 @@ def simulate(
     vibration: Annotated[float, typer.Option("--vibration", help="RMS speed vibration, fraction of speed.")] = 0.05,
     misalignment: Annotated[float, typer.Option("--misalignment", help="Mounting misalignment [deg], <= 10.")] = 5.0,
     k: Annotated[Optional[str], typer.Option(
-        "--k", help="True scale factors kx,ky,kz (the servo method of Wang et al., eq. 1).")] = None,
+        "--k", help="True scale factors kx,ky,kz (the servo method of Wang et al., eq. 1) (default: 1,1,1).")] = None,
     b: Annotated[Optional[str], typer.Option(
-        "--b", help="True biases bx,by,bz [rad/s] (the servo method of Wang et al., eq. 1).")] = None,
-    noise: Annotated[Optional[float], typer.Option("--noise", help="Per-sample white noise [rad/s].")] = None,
+        "--b", help="True biases bx,by,bz [rad/s] (the servo method of Wang et al., eq. 1) (default: 0,0,0).")] = None,
+    noise: Annotated[Optional[float], typer.Option("--noise", help="Per-sample white noise [rad/s] (default: 0.035, the paper's; 0.005 for the turntable).")] = None,
     noise_density: NoiseDensity = None,
     bias_instability: Annotated[float, typer.Option("--bias-instability", help="Gauss-Markov bias std [rad/s].")] = 0.0,
     rate_random_walk: Annotated[float, typer.Option("--rrw", help="Rate random walk [rad/s/sqrt(s)].")] = 0.0,
-    quantum: Annotated[Optional[float], typer.Option("--quantum", help="Output resolution [rad/s].")] = None,
-    full_scale: Annotated[Optional[float], typer.Option("--full-scale", help="Saturation [deg/s].")] = None,
-    profile: Annotated[Optional[Path], typer.Option("--profile", help="--protocol profile: CSV of t,wx,wy,wz.")] = None,
+    quantum: Annotated[Optional[float], typer.Option("--quantum", help="Output resolution [rad/s] (default: none, not quantised).")] = None,
+    full_scale: Annotated[Optional[float], typer.Option("--full-scale", help="Saturation [deg/s] (default: none, never saturates).")] = None,
+    profile: Annotated[Optional[Path], typer.Option("--profile", help="--protocol profile: CSV of t,wx,wy,wz (required there).")] = None,
     profile_units: Annotated[str, typer.Option("--profile-units", help="Unit of the profile rates.")] = "rad/s",
     duration: Annotated[Optional[float], typer.Option(
-        "--duration", help="--protocol profile, static: length [s].")] = None,
+        "--duration", help="--protocol profile, static: length [s] (required there).")] = None,
     temp_start: Annotated[float, typer.Option(
         "--temp-start", help="--protocol static: temperature at power-on [degC].")] = 25.0,
     temp_end: Annotated[float, typer.Option(
@@ -114,12 +114,14 @@ def simulate(
         "--warmup-tau", help="--protocol static: time constant of the exponential warm-up [s].")] = 600.0,
     bias_tempco: Annotated[Optional[str], typer.Option(
         "--bias-tempco", help="--protocol static: bias against temperature, x,y,z [rad/s/degC^n] for n = 1, 2, .. "
-                              "about 25 degC, ';' between powers (e.g. 1e-4,-5e-5,2e-5;1e-6,0,0).")] = None,
+                              "about 25 degC, ';' between powers, e.g. 1e-4,-5e-5,2e-5;1e-6,0,0 (default: none, "
+                              "no temperature dependence).")] = None,
     accel_noise_density: Annotated[Optional[float], typer.Option(
         "--accel-noise-density", help="--protocol static: also an accelerometer (gravity on z), white noise "
-                                      "[m/s^2/sqrt(Hz)].")] = None,
+                                      "[m/s^2/sqrt(Hz)] (default: none, no accelerometer).")] = None,
     accel_random_walk: Annotated[Optional[float], typer.Option(
-        "--accel-random-walk", help="--protocol static: accelerometer bias random walk [m/s^3/sqrt(Hz)].")] = None,
+        "--accel-random-walk", help="--protocol static: accelerometer bias random walk [m/s^3/sqrt(Hz)] (default: "
+                                    "none, no accelerometer; 0 with --accel-noise-density).")] = None,
     temps: Annotated[Optional[str], typer.Option(
         "--temps", help="--protocol turntable: temperatures [degC], comma-separated (default: the full-temperature-"
                         "range method's Table 1, -40 to 50 by 10).")] = None,
@@ -133,7 +135,7 @@ def simulate(
         "--temp-noise", help="--protocol turntable, static: std of each temperature reading [degC].")] = 0.0,
     temp_quantum: Annotated[Optional[float], typer.Option(
         "--temp-quantum", help="--protocol turntable, static: resolution of the temperature readings [degC], "
-                               "e.g. 1.")]
+                               "e.g. 1 (default: none, not quantised).")]
     = None,
     sample_rate: Annotated[float, typer.Option("--sample-rate", help="Sampling rate [Hz].")] = 200.0,
     units: Annotated[str, typer.Option("--units", help="Unit of the written gyro columns.")] = "deg/s",
@@ -147,7 +149,7 @@ def simulate(
     wire: Annotated[DeviceWire, typer.Option("--wire", help="--device: gyrocal frames or text lines.")] = "frames",
     faults: Annotated[str | None, typer.Option(
         "--faults", help="--device: drop=P,corrupt=P (per byte),stall=AT:SECONDS,disconnect=AT (AT: fraction of "
-                         "the stream).")] = None,
+                         "the stream) (default: none).")] = None,
     pace: Annotated[float, typer.Option(
         "--pace", help="--device: 1 = real time, 10 = ten times faster, 0 = as fast as the reader reads.")] = 1.0,
 ) -> None:
