@@ -41,7 +41,7 @@ class FitQuality:
     warnings: tuple[str, ...] = field(default_factory=tuple)
 
     def to_dict(self) -> dict:
-        nan = lambda x: None if not np.isfinite(x) else float(x)  # noqa: E731
+        nan = lambda x: None if not np.isfinite(x) else float(x)
         return {"chi2": float(self.chi2), "dof": int(self.dof), "p_value": nan(self.p_value),
                 "birge_ratio": nan(self.birge_ratio), "covariance_scaled": bool(self.covariance_scaled),
                 "warnings": list(self.warnings)}

@@ -107,8 +107,8 @@ class GyroProblem:
         """Second direction of each pair predicted from the first and the integrated attitude change."""
         if not len(self.pairs):
             return np.zeros((0, 3))
-        dq = quat.attitude_change(self.t_cat, self.omega_params(a, b, g), self.bounds)
-        return np.einsum("pji,pj->pi", quat.to_matrix(dq), directions[self.pairs[:, 0]])
+        rot = quat.attitude_matrices(self.t_cat, self.omega_params(a, b, g), self.bounds)
+        return np.einsum("pji,pj->pi", rot, directions[self.pairs[:, 0]])
 
     def pair_sigma(self, a, directions_std) -> np.ndarray:
         scale2 = float(np.mean(np.diag(a) ** 2))

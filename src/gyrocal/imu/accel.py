@@ -33,8 +33,16 @@ from ..errors import DegenerateDesignError, InputError
 from . import _fit
 from .poses import coverage, triangular_frame
 
-__all__ = ["ACCEL_MODELS", "AccelFit", "AccelModel", "MIN_DOF", "directions_of", "fit_accelerometer", "normal_gravity",
-           "param_names"]
+__all__ = [
+    "ACCEL_MODELS",
+    "MIN_DOF",
+    "AccelFit",
+    "AccelModel",
+    "directions_of",
+    "fit_accelerometer",
+    "normal_gravity",
+    "param_names",
+]
 
 AccelModel = Literal["affine", "triangular", "scale-bias"]
 ACCEL_MODELS: tuple[str, ...] = get_args(AccelModel)

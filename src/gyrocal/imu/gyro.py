@@ -18,11 +18,11 @@ from typing import Literal, get_args
 
 import numpy as np
 from scipy import stats
-from scipy.optimize import least_squares
 
 from ..errors import DegenerateDesignError, InputError
 from . import _fit
 from ._gyro_problem import GyroProblem, Turn, build_problem
+from ._gyro_solve import MASKS, initial_scale, jacobian, residuals, screen_pairs, solve, unpack
 from .accel import AccelFit, directions_of
 
 __all__ = ["GYRO_MODELS", "GyroFit", "GyroModel", "PairCheck", "Turn", "fit_gyroscope"]
@@ -33,12 +33,9 @@ MIN_DOF = 3
 DETERMINED_REL = 0.05
 #: A pose pair or turn whose own chi-square has a p-value below this is named as disagreeing.
 DISAGREE_P = 1e-3
-#: Re-weighting rounds of the equation groups (variance-component estimation).
-_VCE_ITER = 8
 #: Names of the equation groups, in residual order.
 GROUPS = ("still poses", "pose pairs", "known-angle turns")
 _AXES = "xyz"
-_MASKS = {"affine": np.ones((3, 3), dtype=bool), "scale": np.eye(3, dtype=bool)}
 
 
 @dataclass(frozen=True)
@@ -101,6 +98,8 @@ class GyroFit:
     noise_factors : dict
         For each equation group (still poses, pose pairs, known-angle turns), how many times
         its noise model its residuals scatter (variance-component estimation; 1 = as predicted).
+    left_out : tuple of str
+        Pose pairs left out of the fit as gross outliers (they stay in :attr:`checks`).
     """
 
     model: GyroModel
@@ -112,6 +111,7 @@ class GyroFit:
     checks: tuple[PairCheck, ...]
     choice: tuple[str, ...] = field(default_factory=tuple)
     noise_factors: dict = field(default_factory=dict)
+    left_out: tuple[str, ...] = ()
 
     @property
     def param_names(self) -> tuple[str, ...]:
@@ -120,7 +120,7 @@ class GyroFit:
     @property
     def params(self) -> np.ndarray:
         extra = () if self.g_sensitivity is None else (self.g_sensitivity.ravel(),)
-        return np.concatenate([self.matrix[_MASKS[self.model]], self.offset, *extra])
+        return np.concatenate([self.matrix[MASKS[self.model]], self.offset, *extra])
 
     @property
     def std(self) -> np.ndarray:
@@ -132,63 +132,13 @@ class GyroFit:
 
 
 def _names(model: str, with_g: bool) -> tuple[str, ...]:
-    rows, cols = np.nonzero(_MASKS[model])
+    rows, cols = np.nonzero(MASKS[model])
     names = tuple(f"A_{_AXES[r]}{_AXES[c]}" for r, c in zip(rows, cols)) + ("o_x", "o_y", "o_z")
     return names + (tuple(f"G_{_AXES[r]}{_AXES[c]}" for r in range(3) for c in range(3)) if with_g else ())
 
 
-def _unpack(model, with_g, p):
-    k = int(_MASKS[model].sum())
-    a = np.zeros((3, 3))
-    a[_MASKS[model]] = p[:k]
-    return a, p[k:k + 3], (p[k + 3:k + 12].reshape(3, 3) if with_g else None)
-
-
-def _residuals(prob: GyroProblem, model, with_g, p, directions, directions_std):
-    a, b, g = _unpack(model, with_g, p)
-    return np.concatenate([prob.static_residuals(b, g), prob.pair_residuals(a, b, g, directions, directions_std),
-                           prob.turn_residuals(a, b, g)])
-
-
-def _jacobian(fun, p: np.ndarray) -> np.ndarray:
-    """Central-difference Jacobian of `fun` at `p`."""
-    cols = []
-    for j in range(p.size):
-        h = 1e-6 * max(abs(p[j]), 1e-3 * float(np.abs(p).max()), 1e-12)
-        dp = np.zeros_like(p)
-        dp[j] = h
-        cols.append((fun(p + dp) - fun(p - dp)) / (2 * h))
-    return np.column_stack(cols)
-
-
-def _initial_scale(prob: GyroProblem, bias, directions, directions_std) -> float:
-    """Gyro scale [rad/s per raw unit] that best joins the poses with ``A = c I``, by a grid over c.
-
-    The grid is centred on the ratio of the tilt between poses to the integrated raw reading,
-    which is below the true scale when a move also turns about the vertical.
-    """
-    guesses = []
-    if len(prob.pairs):
-        ang = np.linalg.norm(prob.pair_integrals(bias), axis=1)
-        tilt = np.arccos(np.clip(np.einsum("pi,pi->p", directions[prob.pairs[:, 0]], directions[prob.pairs[:, 1]]),
-                                 -1, 1))
-        ok = (tilt > np.radians(20)) & (ang > 0)
-        guesses += list(tilt[ok] / ang[ok])
-    if prob.turns:
-        norm = np.linalg.norm(prob.turn_m - prob.turn_time[:, None] * bias, axis=1)
-        guesses += [t.angle / n for t, n in zip(prob.turns, norm) if n > 0]
-    if not guesses:
-        raise DegenerateDesignError("no turn between still poses changes the gravity direction by 20 deg or more, "
-                                    "so the gyro scale cannot be found; tilt the board between poses")
-    c0 = float(np.median(guesses))
-    grid = c0 * np.exp(np.linspace(np.log(0.5), np.log(4.0), 141))
-    cost = [np.sum(_residuals(prob, "scale", False, np.concatenate([[c, c, c], bias]), directions,
-                              directions_std) ** 2) for c in grid]
-    return float(grid[int(np.argmin(cost))])
-
-
 def _checks(prob: GyroProblem, p, model, with_g, statics, directions, directions_std) -> tuple[PairCheck, ...]:
-    a, b, g = _unpack(model, with_g, p)
+    a, b, g = unpack(model, with_g, p)
     out = []
     if len(prob.pairs):
         r = prob.pair_residuals(a, b, g, directions, directions_std).reshape(-1, 2)
@@ -219,36 +169,12 @@ def quat_angles(t, omega, bounds) -> np.ndarray:
     return 2 * np.arccos(np.clip(np.abs(q[:, 0]), 0, 1))
 
 
-def _solve(prob, model, with_g, p0, directions, directions_std):
-    """Fit, re-weighting the equation groups (poses, pairs, turns) by their own scatter until it settles.
-
-    Sets ``prob.factors`` to the groups' noise factors (1 where the noise model holds).
-    """
-    groups = np.repeat(np.arange(3), [prob.means.size, 2 * len(prob.pairs), 3 * len(prob.turns)])
-    prob.factors = np.ones(3)
-
-    def fun(q):
-        return _residuals(prob, model, with_g, q, directions, directions_std)
-
-    p = p0
-    for _ in range(_VCE_ITER):
-        sol = least_squares(fun, p, method="lm", x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=2000)
-        p = sol.x
-        r, jac = fun(p), _jacobian(fun, p)
-        new = _fit.group_factors(r, jac, groups, prob.factors)
-        if np.allclose(new, prob.factors, rtol=0.01):
-            break
-        prob.factors = new
-    r, jac = fun(p), _jacobian(fun, p)
-    return p, r, jac
-
-
 def _accel_term(prob, model, with_g, p, jac, accel: AccelFit, means, directions_std) -> np.ndarray:
     """Covariance the accelerometer's calibration error adds to the gyro parameters (through the directions)."""
     def fun_alpha(alpha):
-        return _residuals(prob, model, with_g, p, directions_of(accel, alpha, means), directions_std)
+        return residuals(prob, model, with_g, p, directions_of(accel, alpha, means), directions_std)
 
-    j_alpha = _jacobian(fun_alpha, accel.params)
+    j_alpha = jacobian(fun_alpha, accel.params)
     gain = np.linalg.lstsq(jac, j_alpha, rcond=None)[0]
     return gain @ accel.covariance @ gain.T
 
@@ -256,9 +182,9 @@ def _accel_term(prob, model, with_g, p, jac, accel: AccelFit, means, directions_
 def _why_not(model, p, cov, rank, k) -> str | None:
     if rank < k:
         return f"the turns leave {k - rank} parameter(s) free"
-    a, _, _ = _unpack(model, False, p)
+    a, _, _ = unpack(model, False, p)
     scale = float(np.abs(np.diag(a)).mean())
-    n = int(_MASKS[model].sum())
+    n = int(MASKS[model].sum())
     rel = np.sqrt(np.diag(cov))[:n] / scale
     if rel.max() > DETERMINED_REL:
         return (f"{_names(model, False)[int(np.argmax(rel))]} is not determined by these turns "
@@ -294,32 +220,49 @@ def fit_gyroscope(t, gyro, force, statics, accel: AccelFit, *, pairs=None, turns
     if len(statics) != len(accel.directions):
         raise InputError(f"{len(statics)} statics but the accelerometer fit has {len(accel.directions)} poses")
     pairs = np.array([(i, i + 1) for i in range(len(statics) - 1)]) if pairs is None else np.asarray(pairs, int)
-    means = np.array([s.accel_mean for s in statics])
+    ctx = _Context(statics=tuple(statics), accel=accel, g_sensitivity=g_sensitivity,
+                   bias0=np.average([s.gyro_mean for s in statics], axis=0, weights=[s.count for s in statics]))
     d, d_std = accel.directions, accel.direction_std
-    bias0 = np.average([s.gyro_mean for s in statics], axis=0, weights=[s.count for s in statics])
-    prob = build_problem(t, gyro, force, statics, pairs, turns, 1.0)
-    c = _initial_scale(prob, bias0, d, d_std)
-    prob = build_problem(t, gyro, force, statics, pairs, turns, c)
+    ctx.scale = initial_scale(build_problem(t, gyro, force, statics, pairs, turns, 1.0), ctx.bias0, d, d_std)
+    ctx.everything = build_problem(t, gyro, force, statics, pairs, turns, ctx.scale)
+    keep = screen_pairs(ctx.everything, np.concatenate([(ctx.scale * np.eye(3)).ravel(), ctx.bias0]), d, d_std)
+    prob = ctx.everything if keep.all() else build_problem(t, gyro, force, statics, pairs[keep], turns, ctx.scale)
+    ctx.left_out = tuple(f"pose {i + 1} -> {j + 1}" for i, j in pairs[~keep])
     if turns:
-        prob.turn_sign = np.sign(np.einsum("ti,ti->t", prob.turn_vectors(c * np.eye(3), bias0, None),
-                                           np.array([tu.axis for tu in turns])))
-        prob.turn_sign[prob.turn_sign == 0] = 1.0
+        sign = np.sign(np.einsum("ti,ti->t", prob.turn_vectors(ctx.scale * np.eye(3), ctx.bias0, None),
+                                 np.array([tu.axis for tu in turns])))
+        prob.turn_sign = ctx.everything.turn_sign = np.where(sign == 0, 1.0, sign)
+    return _choose(prob, model, ctx)
+
+
+@dataclass
+class _Context:
+    statics: tuple
+    accel: AccelFit
+    g_sensitivity: bool
+    bias0: np.ndarray
+    scale: float = 1.0
+    everything: GyroProblem | None = None  # every pose pair, for the checks
+    left_out: tuple[str, ...] = ()
+
+
+def _choose(prob: GyroProblem, model, ctx: _Context) -> GyroFit:
+    """Fit the largest model the turns determine with spare equations (or the one asked for)."""
+    d, d_std = ctx.accel.directions, ctx.accel.direction_std
     choice, fallback = [], None
-    candidates = [model] if model != "auto" else list(GYRO_MODELS)
-    for m in candidates:
-        k = int(_MASKS[m].sum()) + 3
-        turn_eqs = prob.equations - 3 * len(statics)
+    for m in ([model] if model != "auto" else list(GYRO_MODELS)):
+        k = int(MASKS[m].sum()) + 3
+        turn_eqs = prob.equations - 3 * len(ctx.statics)
         if turn_eqs + 3 < k:
             choice.append(f"{m}: {k} parameters but the turns give only {turn_eqs} equations")
             continue
-        p, r, jac = _solve(prob, m, False, np.concatenate([(c * np.eye(3))[_MASKS[m]], bias0]), d, d_std)
+        p, r, jac = solve(prob, m, False, np.concatenate([(ctx.scale * np.eye(3))[MASKS[m]], ctx.bias0]), d, d_std)
         q = _fit.quality(r, k, "gyro fit")
         rank, _ = _fit.relative_rank(jac)
-        cov = _fit.covariance(jac, q) if rank == k else None
-        why = _why_not(m, p, cov, rank, k)
+        why = _why_not(m, p, _fit.covariance(jac, q) if rank == k else None, rank, k)
         if why is None and (q.dof >= MIN_DOF or model != "auto"):
             choice.append(f"{m}: fitted ({q.dof} spare equations)")
-            return _finish(prob, (m, p, r, jac, q), choice, statics, accel, means, g_sensitivity)
+            return _finish(prob, (m, p, r, jac, q), choice, ctx)
         if why is None:
             why = f"only {q.dof} spare equation(s), {MIN_DOF} needed to check the fit"
             fallback = fallback or ((m, p, r, jac, q), prob.factors.copy(), len(choice))
@@ -327,7 +270,7 @@ def fit_gyroscope(t, gyro, force, statics, accel: AccelFit, *, pairs=None, turns
     if fallback is not None:
         solution, prob.factors, i = fallback
         choice[i] = f"{solution[0]}: fitted with {solution[4].dof} spare equation(s), too few to check it"
-        return _finish(prob, solution, choice, statics, accel, means, g_sensitivity)
+        return _finish(prob, solution, choice, ctx)
     raise DegenerateDesignError("the turns between the still poses determine no gyro model: "
                                 + "; ".join(choice) + "; turn the board about each of its axes between poses")
 
@@ -336,8 +279,8 @@ def _with_g(prob, solution, accel, choice):
     """The solution refitted with a g-sensitivity, when the still poses determine it."""
     m, p, *_ = solution
     keep = prob.factors.copy()
-    p_g, r_g, jac_g = _solve(prob, m, True, np.concatenate([p, np.zeros(9)]), accel.directions,
-                             accel.direction_std)
+    p_g, r_g, jac_g = solve(prob, m, True, np.concatenate([p, np.zeros(9)]), accel.directions,
+                            accel.direction_std)
     rank, _ = _fit.relative_rank(jac_g)
     if rank < p_g.size:
         prob.factors = keep
@@ -347,21 +290,25 @@ def _with_g(prob, solution, accel, choice):
     return (m, p_g, r_g, jac_g, q_g), True, choice + ["g-sensitivity: fitted from the still poses"]
 
 
-def _finish(prob, solution, choice, statics, accel, means, g_sensitivity) -> GyroFit:
+def _finish(prob, solution, choice, ctx: _Context) -> GyroFit:
     with_g = False
-    if g_sensitivity:
-        solution, with_g, choice = _with_g(prob, solution, accel, choice)
+    if ctx.g_sensitivity:
+        solution, with_g, choice = _with_g(prob, solution, ctx.accel, choice)
     m, p, r, jac, q = solution
-    d, d_std = accel.directions, accel.direction_std
-    cov = _fit.covariance(jac, q) + _accel_term(prob, m, with_g, p, jac, accel, means, d_std)
-    a, b, g = _unpack(m, with_g, p)
-    checks = _checks(prob, p, m, with_g, statics, d, d_std)
+    accel = ctx.accel
+    means = np.array([s.accel_mean for s in ctx.statics])
+    cov = _fit.covariance(jac, q) + _accel_term(prob, m, with_g, p, jac, accel, means, accel.direction_std)
+    a, b, g = unpack(m, with_g, p)
+    ctx.everything.factors = prob.factors
+    checks = _checks(ctx.everything, p, m, with_g, ctx.statics, accel.directions, accel.direction_std)
     notes = tuple(f"gyro fit: the {name} scatter {f:.2g} times their noise model; they were given that much less "
                   "weight and the uncertainties include it" for name, f in zip(GROUPS, prob.factors) if f > 1.0)
     bad = tuple(f"gyro: {c.label} disagrees with the other {c.kind}s (misfit {c.residual_deg:.2g} deg, "
-                f"p = {c.p_value:.1g}): the board may have moved during a pose, or the gyro saturated"
+                f"p = {c.p_value:.1g}){' and was left out' if c.label in ctx.left_out else ''}: "
+                "the board may have moved during a pose, or the gyro saturated"
                 for c in checks if c.disagrees)
     q = _fit.FitQuality(q.chi2, q.dof, q.p_value, q.birge_ratio, q.covariance_scaled or bool(notes),
                         q.warnings + notes + bad)
     return GyroFit(model=m, matrix=a, offset=b, g_sensitivity=g, covariance=cov, fit=q, checks=checks,
-                   choice=tuple(choice), noise_factors=dict(zip(GROUPS, prob.factors.tolist())))
+                   choice=tuple(choice), noise_factors=dict(zip(GROUPS, prob.factors.tolist())),
+                   left_out=ctx.left_out)

@@ -21,8 +21,15 @@ import numpy as np
 from .._validation import finite_array
 from . import quaternion as quat
 
-__all__ = ["Coverage", "coverage", "distinct_directions", "fibonacci_directions", "pose_sequence",
-           "triangular_frame", "UP"]
+__all__ = [
+    "UP",
+    "Coverage",
+    "coverage",
+    "distinct_directions",
+    "fibonacci_directions",
+    "pose_sequence",
+    "triangular_frame",
+]
 
 #: World "up": the specific force of a board at rest points along it.
 UP = np.array([0.0, 0.0, 1.0])

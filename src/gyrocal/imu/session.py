@@ -58,6 +58,8 @@ class ImuCalibrationResult:
         Of the calibrated gravity directions.
     accel : AccelFit
     gyro : GyroFit
+    turns : tuple of Turn
+        Known-angle turns used (Ferraris sessions), with the vertical measured beside each.
     warnings : tuple of str
     """
 
@@ -67,6 +69,7 @@ class ImuCalibrationResult:
     coverage: Coverage
     accel: AccelFit
     gyro: GyroFit
+    turns: tuple[Turn, ...] = field(default_factory=tuple)
     warnings: tuple[str, ...] = field(default_factory=tuple)
 
 
@@ -183,4 +186,5 @@ def calibrate_imu(t, gyro, accel, *, gravity: float = 9.80665, windows: Sequence
         warnings.append(f"the poses cover the sphere poorly (spread {cov.spread:.2f} of 1); add poses with the "
                         f"sensor direction ({', '.join(f'{v:+.2f}' for v in cov.weakest_axis)}) up or down")
     return ImuCalibrationResult(kind="ferraris" if ferraris else "multi-position", statics=tuple(statics),
-                                detection=detection, coverage=cov, accel=afit, gyro=gfit, warnings=tuple(warnings))
+                                detection=detection, coverage=cov, accel=afit, gyro=gfit, turns=tuple(turns),
+                                warnings=tuple(warnings))

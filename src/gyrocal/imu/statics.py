@@ -124,13 +124,25 @@ def _moving(x: np.ndarray, w: int) -> tuple[np.ndarray, np.ndarray]:
     return mean, var
 
 
-def _noise_and_threshold(var: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+def _variance_floor(x: np.ndarray) -> np.ndarray:
+    """Smallest noise variance an axis can show (3,): its rounding, ``q^2 / 12``, or 1e-12 of its range squared.
+
+    Quantised readings at rest can be constant for seconds; without a floor their variance is 0.
+    """
+    sub = x[:: max(1, len(x) // 100000)]
+    step = np.abs(np.diff(sub, axis=0))
+    quantum = np.array([np.min(s[s > 0]) if np.any(s > 0) else 0.0 for s in step.T])
+    span = np.ptp(sub, axis=0)
+    return np.maximum(quantum**2 / 12.0, (1e-6 * np.maximum(span, np.abs(sub).max(axis=0))) ** 2) + 1e-300
+
+
+def _noise_and_threshold(var: np.ndarray, floor_var: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
     """Per-axis noise variance, the normalised statistic (N,) and its threshold, from moving variances."""
+    var = np.maximum(var, floor_var)
     total = var.sum(axis=1)
     floor = np.percentile(total, _QUIET_PERCENTILE)
-    quiet = total <= _QUIET_FACTOR * max(floor, np.finfo(float).tiny)
+    quiet = total <= _QUIET_FACTOR * floor
     noise = np.median(var[quiet], axis=0)
-    noise = np.maximum(noise, 1e-12 * max(float(noise.max()), np.finfo(float).tiny))
     stat = (var / noise).sum(axis=1)
     q = stat[quiet]
     med = float(np.median(q))
@@ -228,8 +240,8 @@ def detect_statics(t, gyro, accel, *, window_s: float = 0.5, min_duration: float
         raise InputError(f"the session has {len(t)} samples; detecting still poses needs at least {4 * w}")
     mean_a, var_a = _moving(accel, w)
     mean_g, var_g = _moving(gyro, w)
-    noise_a, stat_a, thr_a = _noise_and_threshold(var_a)
-    noise_g, stat_g, thr_g = _noise_and_threshold(var_g)
+    noise_a, stat_a, thr_a = _noise_and_threshold(var_a, _variance_floor(accel))
+    noise_g, stat_g, thr_g = _noise_and_threshold(var_g, _variance_floor(gyro))
     quiet = (stat_a <= thr_a) & (stat_g <= thr_g)
     still = quiet & _near_still_level(mean_g, quiet)
     edges = np.flatnonzero(np.diff(np.concatenate(([0], still.view(np.int8), [0]))))

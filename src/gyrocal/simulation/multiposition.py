@@ -174,12 +174,14 @@ class ImuSession:
 
 
 def _times(duration: float, fs: float, uneven: float, rng: np.random.Generator) -> np.ndarray:
+    """Sample times from 0 to `duration` [s]: nominal steps, a fraction `uneven` of them 0.5, 1.5 or 2 times longer."""
     n = int(np.ceil(duration * fs)) + 1
     steps = np.full(n - 1, 1.0 / fs)
     if uneven > 0:
         odd = rng.random(n - 1) < uneven
         steps[odd] *= rng.choice([0.5, 1.5, 2.0], size=int(odd.sum()))
-    return np.concatenate([[0.0], np.cumsum(steps)])
+    t = np.concatenate([[0.0], np.cumsum(steps)])
+    return t[t <= duration + 1e-9]
 
 
 def _segments(q: np.ndarray, p: MultiPositionProtocol, rng: np.random.Generator) -> list[tuple]:
