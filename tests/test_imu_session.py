@@ -64,7 +64,8 @@ def test_a_slow_steady_turn_is_not_a_pose():
 def test_noise_free_session_recovers_both_sensors_exactly():
     """Reference: the simulated truth. Without noise only the integration error is left: third order per step,
     largest on the 20 ms steps of dropped samples, and far below the 4e-4 a noisy session reaches."""
-    s = _session(2, gyro_noise=0.0, accel_noise=1e-9)
+    s = _session(2, MultiPositionProtocol(poses=14, static_duration=(1.5, 2.5), uneven_steps=0.03, latitude_deg=None),
+                 gyro_noise=0.0, accel_noise=1e-9)
     r = calibrate_imu(s.t, s.gyro, s.accel)
     assert r.accel.model == "triangular" and r.gyro.model == "affine"
     np.testing.assert_allclose(r.accel.matrix, s.truth["accel_matrix"], atol=1e-9)
@@ -102,7 +103,7 @@ def test_a_pose_pair_that_disagrees_is_named_and_left_out():
     assert [c.label for c in r.gyro.disagreeing] == ["pose 7 -> 8"]
     assert r.gyro.left_out == ("pose 7 -> 8",)
     assert any("pose 7 -> 8 disagrees" in w and "left out" in w for w in r.warnings)
-    assert r.gyro.noise_factors["pose pairs"] < 1.5
+    assert r.gyro.noise_factors["turns between poses"] < 1.5
 
 
 def test_gyro_g_sensitivity_is_recovered_where_the_poses_determine_it():

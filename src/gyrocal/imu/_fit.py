@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import stats
 
-__all__ = ["FitQuality", "covariance", "group_factors", "quality", "relative_rank"]
+__all__ = ["FitQuality", "covariance", "group_factors", "quality", "redundancy", "relative_rank"]
 
 #: A fit is scaled by its Birge ratio when chi2 / dof is above 1 with a p-value below this.
 SCALE_P = 0.05
@@ -41,10 +41,13 @@ class FitQuality:
     warnings: tuple[str, ...] = field(default_factory=tuple)
 
     def to_dict(self) -> dict:
-        nan = lambda x: None if not np.isfinite(x) else float(x)
-        return {"chi2": float(self.chi2), "dof": int(self.dof), "p_value": nan(self.p_value),
-                "birge_ratio": nan(self.birge_ratio), "covariance_scaled": bool(self.covariance_scaled),
+        return {"chi2": float(self.chi2), "dof": int(self.dof), "p_value": _finite_or_none(self.p_value),
+                "birge_ratio": _finite_or_none(self.birge_ratio), "covariance_scaled": bool(self.covariance_scaled),
                 "warnings": list(self.warnings)}
+
+
+def _finite_or_none(x: float) -> float | None:
+    return float(x) if np.isfinite(x) else None
 
 
 def quality(residuals: np.ndarray, n_params: int, what: str) -> FitQuality:
@@ -80,25 +83,29 @@ def covariance(jac: np.ndarray, fit: FitQuality) -> np.ndarray:
     return cov * fit.birge_ratio**2 if fit.covariance_scaled else cov
 
 
-def group_factors(residuals: np.ndarray, jac: np.ndarray, groups: np.ndarray, factors: np.ndarray) -> np.ndarray:
-    """One step of variance-component estimation: new noise factors (>= 1) of each equation group.
-
-    Each group's chi-square is compared with its share of the degrees of freedom (the sum of its
-    equations' redundancy numbers ``1 - h_ii``). A group is inflated when its residuals are
-    significantly above its noise model (p < :data:`SCALE_P`), or keeps being adjusted once it
-    has been; no group is ever trusted more than its noise model says. `residuals` and `jac`
-    are already divided by the current `factors`.
-    """
+def redundancy(jac: np.ndarray, groups: np.ndarray, n_groups: int) -> np.ndarray:
+    """Sum over each group of its equations' redundancy numbers ``1 - h_ii``: the group's share of the dof."""
     u, s, _ = np.linalg.svd(jac, full_matrices=False)
     u = u[:, s > RANK_RTOL * s[0]] if s.size and s[0] > 0 else u[:, :0]
-    redundancy = 1.0 - np.einsum("ij,ij->i", u, u)
+    r = 1.0 - np.einsum("ij,ij->i", u, u)
+    return np.array([r[groups == k].sum() for k in range(n_groups)])
+
+
+def group_factors(residuals: np.ndarray, groups: np.ndarray, factors: np.ndarray, expected: np.ndarray) -> np.ndarray:
+    """One step of variance-component estimation: new noise factors (>= 1) of each equation group.
+
+    Each group's chi-square is compared with what its noise model leads one to expect after the
+    fit (`expected`, for example the sum of its equations' redundancy numbers ``1 - h_ii`` when
+    the equations are independent). A group is inflated when its residuals are significantly
+    above that (p < :data:`SCALE_P`), or keeps being adjusted once it has been; no group is ever
+    trusted more than its noise model says. `residuals` are already divided by the current `factors`.
+    """
     new = np.array(factors, dtype=float)
     for g in range(len(factors)):
         sel = groups == g
-        dof = float(redundancy[sel].sum())
-        if dof < 0.5:
+        if expected[g] < 0.5:
             continue
         chi2 = float(residuals[sel] @ residuals[sel])
-        if factors[g] > 1.0 or stats.chi2.sf(chi2, dof) < SCALE_P:
-            new[g] = max(1.0, factors[g] * np.sqrt(chi2 / dof))
+        if factors[g] > 1.0 or stats.chi2.sf(chi2, expected[g]) < SCALE_P:
+            new[g] = max(1.0, factors[g] * np.sqrt(chi2 / expected[g]))
     return new

@@ -83,7 +83,7 @@ class GyroProblem:
     turn_sign: np.ndarray      # (T,) sense of each turn about its axis
     turn_span: np.ndarray      # (T, 2) first and last time [s]
     lrv: float                 # long-run noise variance per sample, mean over axes [raw^2]
-    factors: np.ndarray = field(default_factory=lambda: np.ones(3))  # noise factor of poses, pairs, turns
+    factors: np.ndarray = field(default_factory=lambda: np.ones(3))  # noise factors: poses, pairs, turns
 
     def omega_params(self, a, b, g):
         """Corrected rates of the concatenated motion samples [rad/s]."""
@@ -119,7 +119,7 @@ class GyroProblem:
         if not len(self.pairs):
             return np.zeros(0)
         pred = self.pair_prediction(a, b, g, directions)
-        e1, e2 = _tangent_basis(directions[self.pairs[:, 1]])
+        e1, e2 = tangent_basis(directions[self.pairs[:, 1]])
         r = np.stack([np.einsum("pi,pi->p", pred, e1), np.einsum("pi,pi->p", pred, e2)], axis=1)
         return (r / self.pair_sigma(a, directions_std)[:, None]).ravel()
 
@@ -135,8 +135,8 @@ class GyroProblem:
             return np.zeros(0)
         want = np.array([s * t.angle * t.axis for s, t in zip(self.turn_sign, self.turns)])
         scale2 = float(np.mean(np.diag(a) ** 2))
-        sd = self.factors[2] * np.sqrt(self.lrv * scale2 * self.turn_w2 + np.array([(t.angle * t.axis_std) ** 2 for t in self.turns])
-                     + (EARTH_RATE * self.turn_time) ** 2 / 3)
+        axis = np.array([(t.angle * t.axis_std) ** 2 for t in self.turns])
+        sd = self.factors[2] * np.sqrt(self.lrv * scale2 * self.turn_w2 + axis + (EARTH_RATE * self.turn_time) ** 2 / 3)
         return ((self.turn_vectors(a, b, g) - want) / sd[:, None]).ravel()
 
     @property
@@ -144,7 +144,7 @@ class GyroProblem:
         return self.means.size + 2 * len(self.pairs) + 3 * len(self.turns)
 
 
-def _tangent_basis(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def tangent_basis(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Two unit vectors across each unit vector of (P, 3)."""
     helper = np.where(np.abs(v[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
     e1 = np.cross(v, helper)

@@ -8,6 +8,7 @@ from scipy.optimize import least_squares
 
 from ..errors import DegenerateDesignError
 from . import _fit
+from ._gyro_cov import noise_model, whitener
 from ._gyro_problem import GyroProblem
 
 __all__ = ["MASKS", "initial_scale", "jacobian", "residuals", "screen_pairs", "solve", "unpack"]
@@ -69,28 +70,38 @@ def initial_scale(prob: GyroProblem, bias, directions, directions_std) -> float:
     return float(grid[int(np.argmin(cost))])
 
 
-def solve(prob, model, with_g, p0, directions, directions_std):
-    """Fit, re-weighting the equation groups (poses, pairs, turns) by their own scatter until it settles.
+def solve(prob, model, with_g, p0, accel, means):
+    """Generalised least squares, re-weighting the equation groups (poses, pairs, turns) by their own scatter.
 
-    Sets ``prob.factors`` to the groups' noise factors (1 where the noise model holds).
+    Sets ``prob.factors`` to the groups' noise factors (1 where the noise model holds) and returns
+    ``(params, whitened residuals, whitened Jacobian, S)``; ``S`` is the equations' covariance
+    under the noise model (:func:`gyrocal.imu._gyro_cov.noise_model`), the parameter covariance
+    ``(J^T J)^-1`` of the whitened Jacobian.
     """
-    groups = np.repeat(np.arange(3), [prob.means.size, 2 * len(prob.pairs), 3 * len(prob.turns)])
+    # two groups: still poses, and every integrated turn (pose pairs and known-angle turns share the gyro's
+    # integration and its unmodelled errors; three known-angle turns alone would have no spare equation)
+    groups = np.repeat([0, 1], [prob.means.size, 2 * len(prob.pairs) + 3 * len(prob.turns)])
     prob.factors = np.ones(3)
+    d, d_std = accel.directions, accel.direction_std
 
-    def fun(q):
-        return residuals(prob, model, with_g, q, directions, directions_std)
+    def raw(q):
+        return residuals(prob, model, with_g, q, d, d_std)
 
-    p = p0
+    def fit(q):
+        s = noise_model(prob, unpack(model, with_g, q), accel, means)
+        w = whitener(s)
+        q = least_squares(lambda x: w @ raw(x), q, method="lm", x_scale="jac", xtol=1e-12, ftol=1e-12,
+                          gtol=1e-12, max_nfev=2000).x
+        return q, w @ raw(q), w @ jacobian(raw, q), s
+
+    p, r, jac, s = fit(p0)
     for _ in range(_VCE_ITER):
-        sol = least_squares(fun, p, method="lm", x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=2000)
-        p = sol.x
-        r, jac = fun(p), jacobian(fun, p)
-        new = _fit.group_factors(r, jac, groups, prob.factors)
-        if np.allclose(new, prob.factors, rtol=0.01):
+        new = _fit.group_factors(r, groups, prob.factors[:2], _fit.redundancy(jac, groups, 2))
+        if np.allclose(new, prob.factors[:2], rtol=0.01):
             break
-        prob.factors = new
-    r, jac = fun(p), jacobian(fun, p)
-    return p, r, jac
+        prob.factors = new[[0, 1, 1]]
+        p, r, jac, s = fit(p)
+    return p, r, jac, s
 
 
 def screen_pairs(prob: GyroProblem, p0, directions, directions_std) -> np.ndarray:

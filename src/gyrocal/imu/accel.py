@@ -95,6 +95,11 @@ class AccelFit:
         1-sigma of each direction from the pose's noise [rad, per tangent axis].
     choice : tuple of str
         Why this model and not a larger one (one line per model tried).
+    pose_se : ndarray, shape (n, 3)
+        Standard errors of the pose means the fit was given [reading units].
+    gain : ndarray, shape (p, n, 3)
+        Derivative of each parameter with respect to each pose mean, to carry the poses' noise
+        into what is computed from both (the gyro's fit uses the same poses).
     """
 
     model: AccelModel
@@ -107,6 +112,8 @@ class AccelFit:
     directions: np.ndarray
     direction_std: np.ndarray
     choice: tuple[str, ...] = field(default_factory=tuple)
+    pose_se: np.ndarray | None = None
+    gain: np.ndarray | None = None
 
     @property
     def param_names(self) -> tuple[str, ...]:
@@ -216,7 +223,11 @@ def _magnitude_fit(u, se, gravity, model, a0, o0):
     if np.linalg.det(a) < 0:  # |A v| cannot tell A from -A; keep the sign that reads +g when an axis is up
         a = -a
         p = np.concatenate([a[mask], o])
-    return a, o, resid(p, s), jac(p, s)
+    f = (u - o) @ a.T
+    n = f / np.linalg.norm(f, axis=1, keepdims=True)
+    d_u = np.zeros((len(u), len(u), 3))  # d r_p / d u_q: only p = q
+    d_u[np.arange(len(u)), np.arange(len(u))] = (n @ a) / s[:, None]
+    return a, o, resid(p, s), jac(p, s), d_u.reshape(len(u), -1)
 
 
 def _direction_fit(u, se, gravity, d):
@@ -235,7 +246,7 @@ def _direction_fit(u, se, gravity, d):
     d_m = -np.einsum("ik,lj->ijkl", m, m).reshape(9, 9)  # dM_ij / dA_kl
     jac_m = rows[:, :9] * w[:, None]
     jac = np.column_stack([-jac_m @ d_m, -rows[:, 9:] * w[:, None]])
-    return a, o, resid, jac
+    return a, o, resid, jac, np.diag(w)
 
 
 def directions_of(fit: AccelFit, params, means) -> np.ndarray:
@@ -268,13 +279,14 @@ def _undetermined(model, a, o_std, std_a, gravity) -> str | None:
 
 
 def _fit_one(model, u, se, gravity, directions):
+    """Fit one model: ``(A, o, residuals, Jacobian, d residuals / d pose means, rank)``."""
     if model == "affine":
-        a, o, r, jac = _direction_fit(u, se, gravity, directions)
+        a, o, r, jac, d_u = _direction_fit(u, se, gravity, directions)
     else:
         a0, o0 = _initial(u, gravity)
-        a, o, r, jac = _magnitude_fit(u, se, gravity, model, a0, o0)
+        a, o, r, jac, d_u = _magnitude_fit(u, se, gravity, model, a0, o0)
     rank, _ = _fit.relative_rank(jac)
-    return a, o, r, jac, rank
+    return a, o, r, jac, d_u, rank
 
 
 def fit_accelerometer(means, se, *, gravity: float = 9.80665, model: AccelModel | Literal["auto"] = "auto",
@@ -319,29 +331,34 @@ def fit_accelerometer(means, se, *, gravity: float = 9.80665, model: AccelModel 
         if equations < k:
             choice.append(f"{m}: {k} parameters but only {equations} equations from {len(u)} poses")
             continue
-        a, o, r, jac, rank = _fit_one(m, u, se, gravity, d)
+        a, o, r, jac, d_u, rank = _fit_one(m, u, se, gravity, d)
         q = _fit.quality(r, k, "accelerometer fit")
         cov = _fit.covariance(jac, q) if rank == k else None
         why = (f"the poses leave {k - rank} parameter(s) free" if cov is None
                else _undetermined(m, a, np.sqrt(np.diag(cov))[-3:], np.sqrt(np.diag(cov))[:-3], gravity))
         if why is None and (q.dof >= MIN_DOF or model != "auto"):
             choice.append(f"{m}: fitted ({q.dof} spare equations)")
-            return _result(m, a, o, cov, gravity, r, q, u, se, choice)
+            return _result(m, a, o, cov, gravity, r, q, u, se, choice, _gain(jac, d_u, len(u)))
         if why is None:
             why = f"only {q.dof} spare equation(s), {MIN_DOF} needed to check the fit"
-            fallback = fallback or (m, a, o, cov, r, q, len(choice))
+            fallback = fallback or (m, a, o, cov, r, q, len(choice), _gain(jac, d_u, len(u)))
         choice.append(f"{m}: {why}")
     if fallback is not None:
-        m, a, o, cov, r, q, i = fallback
+        m, a, o, cov, r, q, i, gain = fallback
         choice[i] = f"{m}: fitted with {q.dof} spare equation(s), too few to check it"
-        return _result(m, a, o, cov, gravity, r, q, u, se, choice)
+        return _result(m, a, o, cov, gravity, r, q, u, se, choice, gain)
     raise DegenerateDesignError(_too_few_message(u, choice))
 
 
-def _result(m, a, o, cov, gravity, r, q, u, se, choice) -> AccelFit:
+def _gain(jac: np.ndarray, d_u: np.ndarray, n: int) -> np.ndarray:
+    """d params / d pose means (p, n, 3) of a least-squares fit: ``-(J^T J)^-1 J^T dr/du``."""
+    return -np.linalg.lstsq(jac, d_u, rcond=None)[0].reshape(jac.shape[1], n, 3)
+
+
+def _result(m, a, o, cov, gravity, r, q, u, se, choice, gain) -> AccelFit:
     n, n_std = _directions(a, o, u, se)
     return AccelFit(model=m, matrix=a, offset=o, covariance=cov, gravity=gravity, residuals=r, fit=q,
-                    directions=n, direction_std=n_std, choice=tuple(choice))
+                    directions=n, direction_std=n_std, choice=tuple(choice), pose_se=se, gain=gain)
 
 
 def _too_few_message(u, choice) -> str:

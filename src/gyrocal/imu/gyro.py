@@ -21,11 +21,12 @@ from scipy import stats
 
 from ..errors import DegenerateDesignError, InputError
 from . import _fit
-from ._gyro_problem import GyroProblem, Turn, build_problem
-from ._gyro_solve import MASKS, initial_scale, jacobian, residuals, screen_pairs, solve, unpack
-from .accel import AccelFit, directions_of
+from ._gyro_problem import EARTH_RATE, GyroProblem, Turn, build_problem
+from ._gyro_solve import MASKS, initial_scale, screen_pairs, solve, unpack
+from ._gyro_cov import noise_model
+from .accel import AccelFit
 
-__all__ = ["GYRO_MODELS", "GyroFit", "GyroModel", "PairCheck", "Turn", "fit_gyroscope"]
+__all__ = ["EARTH_RATE", "GYRO_MODELS", "GyroFit", "GyroModel", "PairCheck", "Turn", "fit_gyroscope"]
 
 GyroModel = Literal["affine", "scale"]
 GYRO_MODELS: tuple[str, ...] = get_args(GyroModel)
@@ -34,7 +35,7 @@ DETERMINED_REL = 0.05
 #: A pose pair or turn whose own chi-square has a p-value below this is named as disagreeing.
 DISAGREE_P = 1e-3
 #: Names of the equation groups, in residual order.
-GROUPS = ("still poses", "pose pairs", "known-angle turns")
+GROUPS = ("still poses", "turns between poses")
 _AXES = "xyz"
 
 
@@ -96,8 +97,9 @@ class GyroFit:
     choice : tuple of str
         Why this model (one line per model tried), and what became of the g-sensitivity.
     noise_factors : dict
-        For each equation group (still poses, pose pairs, known-angle turns), how many times
-        its noise model its residuals scatter (variance-component estimation; 1 = as predicted).
+        For each equation group (still poses; turns between poses, pose pairs and known-angle
+        turns together), how many times its noise model its residuals scatter
+        (variance-component estimation; 1 = as predicted).
     left_out : tuple of str
         Pose pairs left out of the fit as gross outliers (they stay in :attr:`checks`).
     """
@@ -137,15 +139,20 @@ def _names(model: str, with_g: bool) -> tuple[str, ...]:
     return names + (tuple(f"G_{_AXES[r]}{_AXES[c]}" for r in range(3) for c in range(3)) if with_g else ())
 
 
-def _checks(prob: GyroProblem, p, model, with_g, statics, directions, directions_std) -> tuple[PairCheck, ...]:
+def _checks(prob: GyroProblem, p, model, with_g, statics, accel: AccelFit, means) -> tuple[PairCheck, ...]:
+    """Each pair's and turn's misfit against its own variance under the noise model."""
     a, b, g = unpack(model, with_g, p)
+    directions, directions_std = accel.directions, accel.direction_std
+    var = np.diag(noise_model(prob, (a, b, g), accel, means))  # of the factor-free normalised equations
+    n_static = prob.means.size
     out = []
     if len(prob.pairs):
         r = prob.pair_residuals(a, b, g, directions, directions_std).reshape(-1, 2)
+        v = var[n_static:n_static + 2 * len(prob.pairs)].reshape(-1, 2)
         sig = prob.pair_sigma(a, directions_std)
         dq = quat_angles(prob.t_cat, prob.omega_params(a, b, g), prob.bounds)
-        for (i, j), ri, s, ang in zip(prob.pairs, r, sig, dq):
-            chi2 = float(ri @ ri)
+        for (i, j), ri, vi, s, ang in zip(prob.pairs, r, v, sig, dq):
+            chi2 = float(np.sum(ri**2 / vi))
             out.append(PairCheck("pair", f"pose {i + 1} -> {j + 1}", statics[i].t_stop, statics[j].t_start,
                                  float(np.degrees(ang)), float(np.degrees(np.linalg.norm(ri) * s)), chi2,
                                  float(stats.chi2.sf(chi2, 2))))
@@ -167,16 +174,6 @@ def quat_angles(t, omega, bounds) -> np.ndarray:
 
     q = quat.attitude_change(t, omega, bounds)
     return 2 * np.arccos(np.clip(np.abs(q[:, 0]), 0, 1))
-
-
-def _accel_term(prob, model, with_g, p, jac, accel: AccelFit, means, directions_std) -> np.ndarray:
-    """Covariance the accelerometer's calibration error adds to the gyro parameters (through the directions)."""
-    def fun_alpha(alpha):
-        return residuals(prob, model, with_g, p, directions_of(accel, alpha, means), directions_std)
-
-    j_alpha = jacobian(fun_alpha, accel.params)
-    gain = np.linalg.lstsq(jac, j_alpha, rcond=None)[0]
-    return gain @ accel.covariance @ gain.T
 
 
 def _why_not(model, p, cov, rank, k) -> str | None:
@@ -221,6 +218,7 @@ def fit_gyroscope(t, gyro, force, statics, accel: AccelFit, *, pairs=None, turns
         raise InputError(f"{len(statics)} statics but the accelerometer fit has {len(accel.directions)} poses")
     pairs = np.array([(i, i + 1) for i in range(len(statics) - 1)]) if pairs is None else np.asarray(pairs, int)
     ctx = _Context(statics=tuple(statics), accel=accel, g_sensitivity=g_sensitivity,
+                   means=np.array([s.accel_mean for s in statics]),
                    bias0=np.average([s.gyro_mean for s in statics], axis=0, weights=[s.count for s in statics]))
     d, d_std = accel.directions, accel.direction_std
     ctx.scale = initial_scale(build_problem(t, gyro, force, statics, pairs, turns, 1.0), ctx.bias0, d, d_std)
@@ -240,6 +238,7 @@ class _Context:
     statics: tuple
     accel: AccelFit
     g_sensitivity: bool
+    means: np.ndarray
     bias0: np.ndarray
     scale: float = 1.0
     everything: GyroProblem | None = None  # every pose pair, for the checks
@@ -248,7 +247,6 @@ class _Context:
 
 def _choose(prob: GyroProblem, model, ctx: _Context) -> GyroFit:
     """Fit the largest model the turns determine with spare equations (or the one asked for)."""
-    d, d_std = ctx.accel.directions, ctx.accel.direction_std
     choice, fallback = [], None
     for m in ([model] if model != "auto" else list(GYRO_MODELS)):
         k = int(MASKS[m].sum()) + 3
@@ -256,16 +254,17 @@ def _choose(prob: GyroProblem, model, ctx: _Context) -> GyroFit:
         if turn_eqs + 3 < k:
             choice.append(f"{m}: {k} parameters but the turns give only {turn_eqs} equations")
             continue
-        p, r, jac = solve(prob, m, False, np.concatenate([(ctx.scale * np.eye(3))[MASKS[m]], ctx.bias0]), d, d_std)
+        p0 = np.concatenate([(ctx.scale * np.eye(3))[MASKS[m]], ctx.bias0])
+        p, r, jac, s = solve(prob, m, False, p0, ctx.accel, ctx.means)
         q = _fit.quality(r, k, "gyro fit")
         rank, _ = _fit.relative_rank(jac)
-        why = _why_not(m, p, _fit.covariance(jac, q) if rank == k else None, rank, k)
+        why = _why_not(m, p, _covariance(jac, s, q) if rank == k else None, rank, k)
         if why is None and (q.dof >= MIN_DOF or model != "auto"):
             choice.append(f"{m}: fitted ({q.dof} spare equations)")
-            return _finish(prob, (m, p, r, jac, q), choice, ctx)
+            return _finish(prob, (m, p, r, jac, q, s), choice, ctx)
         if why is None:
             why = f"only {q.dof} spare equation(s), {MIN_DOF} needed to check the fit"
-            fallback = fallback or ((m, p, r, jac, q), prob.factors.copy(), len(choice))
+            fallback = fallback or ((m, p, r, jac, q, s), prob.factors.copy(), len(choice))
         choice.append(f"{m}: {why}")
     if fallback is not None:
         solution, prob.factors, i = fallback
@@ -275,34 +274,37 @@ def _choose(prob: GyroProblem, model, ctx: _Context) -> GyroFit:
                                 + "; ".join(choice) + "; turn the board about each of its axes between poses")
 
 
-def _with_g(prob, solution, accel, choice):
+def _covariance(jac, s, q) -> np.ndarray:
+    """Of the whitened fit: ``(J^T J)^-1``, Birge-scaled when the fit asks (`s` is kept for the checks)."""
+    return _fit.covariance(jac, q)
+
+
+def _with_g(prob, solution, ctx, choice):
     """The solution refitted with a g-sensitivity, when the still poses determine it."""
     m, p, *_ = solution
     keep = prob.factors.copy()
-    p_g, r_g, jac_g = solve(prob, m, True, np.concatenate([p, np.zeros(9)]), accel.directions,
-                            accel.direction_std)
+    p_g, r_g, jac_g, s_g = solve(prob, m, True, np.concatenate([p, np.zeros(9)]), ctx.accel, ctx.means)
     rank, _ = _fit.relative_rank(jac_g)
     if rank < p_g.size:
         prob.factors = keep
         return solution, False, choice + ["g-sensitivity: not determined (it needs still poses in at least four "
                                           "orientations not in one plane)"]
     q_g = _fit.quality(r_g, p_g.size, "gyro fit")
-    return (m, p_g, r_g, jac_g, q_g), True, choice + ["g-sensitivity: fitted from the still poses"]
+    return (m, p_g, r_g, jac_g, q_g, s_g), True, choice + ["g-sensitivity: fitted from the still poses"]
 
 
 def _finish(prob, solution, choice, ctx: _Context) -> GyroFit:
     with_g = False
     if ctx.g_sensitivity:
-        solution, with_g, choice = _with_g(prob, solution, ctx.accel, choice)
-    m, p, r, jac, q = solution
+        solution, with_g, choice = _with_g(prob, solution, ctx, choice)
+    m, p, _, jac, q, s = solution
     accel = ctx.accel
-    means = np.array([s.accel_mean for s in ctx.statics])
-    cov = _fit.covariance(jac, q) + _accel_term(prob, m, with_g, p, jac, accel, means, accel.direction_std)
     a, b, g = unpack(m, with_g, p)
+    cov = _covariance(jac, s, q)
     ctx.everything.factors = prob.factors
-    checks = _checks(ctx.everything, p, m, with_g, ctx.statics, accel.directions, accel.direction_std)
+    checks = _checks(ctx.everything, p, m, with_g, ctx.statics, accel, ctx.means)
     notes = tuple(f"gyro fit: the {name} scatter {f:.2g} times their noise model; they were given that much less "
-                  "weight and the uncertainties include it" for name, f in zip(GROUPS, prob.factors) if f > 1.0)
+                  "weight and the uncertainties include it" for name, f in zip(GROUPS, prob.factors[:2]) if f > 1.0)
     bad = tuple(f"gyro: {c.label} disagrees with the other {c.kind}s (misfit {c.residual_deg:.2g} deg, "
                 f"p = {c.p_value:.1g}){' and was left out' if c.label in ctx.left_out else ''}: "
                 "the board may have moved during a pose, or the gyro saturated"
@@ -310,5 +312,5 @@ def _finish(prob, solution, choice, ctx: _Context) -> GyroFit:
     q = _fit.FitQuality(q.chi2, q.dof, q.p_value, q.birge_ratio, q.covariance_scaled or bool(notes),
                         q.warnings + notes + bad)
     return GyroFit(model=m, matrix=a, offset=b, g_sensitivity=g, covariance=cov, fit=q, checks=checks,
-                   choice=tuple(choice), noise_factors=dict(zip(GROUPS, prob.factors.tolist())),
+                   choice=tuple(choice), noise_factors=dict(zip(GROUPS, prob.factors[:2].tolist())),
                    left_out=ctx.left_out)

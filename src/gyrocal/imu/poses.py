@@ -22,12 +22,15 @@ from .._validation import finite_array
 from . import quaternion as quat
 
 __all__ = [
+    "MIN_JERK_PEAK",
     "UP",
     "Coverage",
     "coverage",
     "distinct_directions",
     "fibonacci_directions",
+    "min_jerk",
     "pose_sequence",
+    "relative_rotvec",
     "triangular_frame",
 ]
 
@@ -110,38 +113,68 @@ def coverage(directions) -> Coverage:
                     empty_cap_centre=_GRID[far].copy())
 
 
-def _tilt(q: np.ndarray, target_up: np.ndarray, angle: float) -> np.ndarray:
-    """Orientation after tilting `q` by `angle` [rad] about the horizontal axis that moves 'up' toward `target_up`."""
-    up_body = quat.rotate(q * [1, -1, -1, -1], UP)  # world up in the body frame
-    axis = np.cross(up_body, target_up)
-    if np.linalg.norm(axis) < 1e-9:
-        axis = np.cross(up_body, [1.0, 0.0, 0.0] if abs(up_body[0]) < 0.9 else [0.0, 1.0, 0.0])
-    axis /= np.linalg.norm(axis)
-    # a body rotation about `axis` by -angle turns the body's view of 'up' toward target_up
-    return quat.multiply(q, quat.from_rotvec(-angle * axis))
+def _next_up(up: np.ndarray, seen: np.ndarray, angle: float) -> np.ndarray:
+    """Of the directions `angle` [rad] away from `up`, the one farthest from every direction `seen`."""
+    helper = np.array([1.0, 0.0, 0.0]) if abs(up[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    e1 = np.cross(up, helper)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(up, e1)
+    phi = np.linspace(0, 2 * np.pi, 144, endpoint=False)[:, None]
+    cand = up * np.cos(angle) + (e1 * np.cos(phi) + e2 * np.sin(phi)) * np.sin(angle)
+    return cand[int(np.argmin((cand @ seen.T).max(axis=1)))]
 
 
 def pose_sequence(n: int, turn_deg: float, *, rng: np.random.Generator | None = None) -> np.ndarray:
     """Orientations (n, 4) of a hand session: each pose a tilt of `turn_deg` from the last.
 
-    The first pose has the sensor's z axis up. Each next pose tilts the board by `turn_deg`
-    about the horizontal axis that brings 'up' (in the sensor frame) closest to the direction
-    farthest from every pose so far, so the poses fill the sphere. With `rng`, a random turn
-    about the vertical (invisible to the accelerometer, as in a real session) is added.
+    The first pose has the sensor's z axis up. Of the orientations one tilt of `turn_deg` away,
+    each next pose takes the one whose 'up' (in the sensor frame) is farthest from every pose
+    so far, so the poses fill the sphere. With `rng`, a random turn about the vertical
+    (invisible to the accelerometer, as in a real session) is added.
     """
     q = np.zeros((n, 4))
     q[0] = [1.0, 0.0, 0.0, 0.0]
     ups = [UP.copy()]
     angle = np.radians(turn_deg)
     for k in range(1, n):
-        nearest = (_GRID @ np.array(ups).T).max(axis=1)
-        target = _GRID[int(np.argmin(nearest))]
-        qk = _tilt(q[k - 1], target, angle)
+        up = ups[-1]
+        new = _next_up(up, np.array(ups), angle)
+        axis = np.cross(up, new)
+        norm = np.linalg.norm(axis)
+        axis = axis / norm if norm > 1e-9 else np.cross(up, [1.0, 0.0, 0.0] if abs(up[0]) < 0.9 else [0.0, 1.0, 0.0])
+        # turning the body by -angle about `axis` moves its view of 'up' from `up` to `new`
+        qk = quat.multiply(q[k - 1], quat.from_rotvec(-angle * axis / np.linalg.norm(axis)))
         if rng is not None:
             qk = quat.multiply(quat.from_rotvec(UP * rng.uniform(-np.pi, np.pi)), qk)
         q[k] = qk / np.linalg.norm(qk)
         ups.append(quat.rotate(q[k] * [1, -1, -1, -1], UP))
     return q
+
+
+#: Peak rate of a minimum-jerk move over its mean rate.
+MIN_JERK_PEAK = 1.875
+
+
+def min_jerk(angle, duration, tau) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Angle [rad], rate [rad/s] and acceleration [rad/s^2] of a minimum-jerk move at fractions `tau` of it.
+
+    A smooth hand move: from rest to rest in `duration` [s] through `angle` [rad], peak rate
+    ``MIN_JERK_PEAK * angle / duration`` at mid-move.
+    """
+    tau = np.clip(tau, 0.0, 1.0)
+    s = angle * (10 * tau**3 - 15 * tau**4 + 6 * tau**5)
+    sd = angle / duration * (30 * tau**2 - 60 * tau**3 + 30 * tau**4)
+    sdd = angle / duration**2 * (60 * tau - 180 * tau**2 + 120 * tau**3)
+    return s, sd, sdd
+
+
+def relative_rotvec(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Body rotation vector [rad] taking orientation `a` to `b` (unit quaternions), the short way."""
+    d = quat.multiply(a * [1, -1, -1, -1], b)
+    d = d * np.sign(d[0]) if d[0] != 0 else d
+    half = np.arccos(np.clip(d[0], -1.0, 1.0))
+    s = np.sin(half)
+    return np.zeros(3) if s < 1e-12 else d[1:] * (2.0 * half / s)
 
 
 def triangular_frame(matrix) -> tuple[np.ndarray, np.ndarray]:

@@ -23,6 +23,7 @@ from .._validation import finite_array, positive
 from ..errors import InputError
 from ..imu import poses as _poses
 from ..imu import quaternion as quat
+from ..imu.gyro import EARTH_RATE
 from .gyro import VirtualGyro
 
 __all__ = ["ImuSession", "MultiPositionProtocol", "VirtualImu", "simulate_multi_position"]
@@ -56,9 +57,8 @@ class VirtualImu:
     g_sensitivity: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
 
     def __post_init__(self):
-        object.__setattr__(self, "accel_matrix", finite_array("accel_matrix", self.accel_matrix, shape_tail=(3, 3), ndim=2))
-        object.__setattr__(self, "accel_offset", finite_array("accel_offset", self.accel_offset, shape_tail=(3,), ndim=1))
-        object.__setattr__(self, "g_sensitivity", finite_array("g_sensitivity", self.g_sensitivity, shape_tail=(3, 3), ndim=2))
+        for name, shape in (("accel_matrix", (3, 3)), ("accel_offset", (3,)), ("g_sensitivity", (3, 3))):
+            object.__setattr__(self, name, finite_array(name, getattr(self, name), shape_tail=shape, ndim=len(shape)))
         if np.linalg.cond(self.accel_matrix) > 1e8:
             raise InputError("accel_matrix is singular")
 
@@ -101,6 +101,9 @@ class MultiPositionProtocol:
         Fraction of time steps that are 0.5, 1.5 or 2 (a dropped sample) times the nominal step.
     gravity : float
         Local gravity [m/s^2].
+    latitude_deg : float or None
+        Latitude [deg]: the gyro also senses the Earth's rotation, 7.29e-5 rad/s about the polar
+        axis (world y is north). None for none.
     """
 
     orientations: np.ndarray | None = None
@@ -114,6 +117,7 @@ class MultiPositionProtocol:
     sample_rate: float = 100.0
     uneven_steps: float = 0.0
     gravity: float = 9.80665
+    latitude_deg: float | None = 45.0
 
     def __post_init__(self):
         if self.orientations is not None:
@@ -193,27 +197,18 @@ def _segments(q: np.ndarray, p: MultiPositionProtocol, rng: np.random.Generator)
         t0 += still
         if k == len(q) - 1:
             break
-        mid = quat.multiply(q[k], quat.from_rotvec(0.5 * _relative_rotvec(q[k], q[k + 1])))
+        mid = quat.multiply(q[k], quat.from_rotvec(0.5 * _poses.relative_rotvec(q[k], q[k + 1])))
         mid = quat.multiply(mid, quat.from_rotvec(rng.standard_normal(3) * np.radians(p.wobble_deg) / np.sqrt(3)))
         for a, b in ((q[k], mid), (mid, q[k + 1])):
-            phi = _relative_rotvec(a, b)
+            phi = _poses.relative_rotvec(a, b)
             angle = float(np.linalg.norm(phi))
             if angle < 1e-9:
                 continue
             peak = np.radians(rng.uniform(*p.peak_rate_deg))
-            duration = 1.875 * angle / peak  # minimum jerk: peak rate = 1.875 angle / duration
+            duration = _poses.MIN_JERK_PEAK * angle / peak
             segs.append((t0, duration, a, phi / angle, angle))
             t0 += duration
     return segs
-
-
-def _relative_rotvec(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Body rotation vector taking orientation `a` to `b` (the short way)."""
-    d = quat.multiply(a * [1, -1, -1, -1], b)
-    d = d * np.sign(d[0]) if d[0] != 0 else d
-    half = np.arccos(np.clip(d[0], -1.0, 1.0))
-    s = np.sin(half)
-    return np.zeros(3) if s < 1e-12 else d[1:] * (2.0 * half / s)
 
 
 def _kinematics(t: np.ndarray, segs: list[tuple]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -221,13 +216,10 @@ def _kinematics(t: np.ndarray, segs: list[tuple]) -> tuple[np.ndarray, np.ndarra
     starts = np.array([s[0] for s in segs])
     idx = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(segs) - 1)
     dur = np.array([s[1] for s in segs])[idx]
-    tau = np.clip((t - starts[idx]) / dur, 0.0, 1.0)
     q0 = np.array([s[2] for s in segs])[idx]
     axis = np.array([s[3] for s in segs])[idx]
     angle = np.array([s[4] for s in segs])[idx]
-    s = angle * (10 * tau**3 - 15 * tau**4 + 6 * tau**5)
-    sd = angle / dur * (30 * tau**2 - 60 * tau**3 + 30 * tau**4)
-    sdd = angle / dur**2 * (60 * tau - 180 * tau**2 + 120 * tau**3)
+    s, sd, sdd = _poses.min_jerk(angle, dur, (t - starts[idx]) / dur)
     q = quat.multiply(q0, quat.from_rotvec(axis * s[:, None]))
     return q, axis * sd[:, None], axis * sdd[:, None]
 
@@ -256,6 +248,9 @@ def simulate_multi_position(imu: VirtualImu, protocol: MultiPositionProtocol | N
     r = np.asarray(p.lever_arm, dtype=float)
     f = quat.rotate(q * [1, -1, -1, -1], p.gravity * _poses.UP)
     f = f + np.cross(alpha, r) + np.cross(w, np.cross(w, r))
+    if p.latitude_deg is not None:
+        lat = np.radians(p.latitude_deg)
+        w = w + quat.rotate(q * [1, -1, -1, -1], EARTH_RATE * np.array([0.0, np.cos(lat), np.sin(lat)]))
     gyro = imu.gyro.measure(w, p.sample_rate, rng) + f @ imu.g_sensitivity.T
     accel = imu.accel(f, rng)
     still = np.array([[np.searchsorted(t, s[0], side="left"), np.searchsorted(t, s[0] + s[1], side="right")]
