@@ -1,4 +1,4 @@
-"""Estimators of the seed 000 scale-bias model.
+"""Estimators of the scale-bias model of the servo method of Wang et al.
 
 Each estimator holds only its configuration; ``fit`` returns a frozen
 :class:`FitResult` and ``fit_batch`` a :class:`BatchFit` over many gyros.
@@ -8,6 +8,7 @@ from ._result import BatchFit, FitResult, Method
 from .algorithm1 import Algorithm1, algorithm1_batch
 from .first_moment import FirstMoment, first_moment_batch
 from .paper_lm import PaperLM, paper_lm_batch
+from .residuals import window_residuals
 
 __all__ = [
     "Algorithm1",
@@ -20,6 +21,7 @@ __all__ = [
     "first_moment_batch",
     "make_estimator",
     "paper_lm_batch",
+    "window_residuals",
 ]
 
 
