@@ -108,7 +108,6 @@ def simulate(
     from ..files import save
     from ..io import write_recording
     from ..models import ScaleBias
-    from ..simulation import VirtualGyro
     from ..simulation.truth import SimulationTruth, truth_path
     from ..units import parse_rate_unit
 
@@ -134,43 +133,14 @@ def simulate(
     settings = {"sample_rate": sample_rate, "noise_std": sd.tolist(), "bias_instability": bias_instability,
                 "rate_random_walk": rate_random_walk, "quantum": quantum, "full_scale_deg_s": full_scale,
                 "seed": seed, "units": unit}
-    facts: dict = {}
     if protocol in _SERVO:
-        from ..simulation.servo import ServoProtocol, simulate_servo
-        from ..simulation.truth import servo_facts
-
-        turn_list = tuple(t.strip() for t in turns.split(",") if t.strip())
-        kw = dict(speed=math.radians(speed), wait=wait, ramp=ramp, misalignment_deg=misalignment)
-        proto = (ServoProtocol.hand(turn_list, **kw) if protocol == "hand"
-                 else ServoProtocol(turns=turn_list, vibration=vibration, **kw))
-        rec, truth = simulate_servo(VirtualGyro(model, **gyro_kw), proto, sample_rate=sample_rate, rng=rng)
-        settings.update(speed_deg_s=speed, turns=list(turn_list), wait_s=wait, ramp_s=ramp, vibration=vibration,
-                        misalignment_deg=misalignment)
-        facts = servo_facts(truth)
+        rec, facts = _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misalignment, sample_rate,
+                            rng, settings)
     elif protocol == "turntable":
-        from ..models import Affine
-        from ..simulation.thermal_truth import ThermalTruth
-        from ..simulation.turntable import simulate_turntable
-
-        proto = _turntable_protocol(temps, rates, step_duration, temp_noise, temp_quantum)
-        thermal = ThermalTruth()
-        K, B = thermal(np.array([thermal.ref_temp]))
-        model = Affine(K[0], B[0])
-        rec = simulate_turntable(VirtualGyro(model, thermal=thermal, **gyro_kw), proto, sample_rate=sample_rate,
-                                 rng=rng)
-        settings.update(temps_degC=list(proto.temps), rates_deg_s=list(proto.rates), axes=list(proto.axes),
-                        step_duration_s=proto.step_duration, table_tau_s=proto.table_tau,
-                        temp_noise_degC=proto.temp_noise, temp_quantum_degC=proto.temp_quantum)
-        facts = {"thermal": thermal.to_dict()}
+        rec, model, facts = _turntable(gyro_kw, _turntable_protocol(temps, rates, step_duration, temp_noise,
+                                                                     temp_quantum), sample_rate, rng, settings)
     else:
-        from ..io import read_profile
-        from ..simulation.profiles import simulate_profile
-
-        if profile is None or duration is None:
-            raise InputError("--protocol profile needs --profile FILE.csv and --duration SECONDS")
-        rec, _ = simulate_profile(VirtualGyro(model, **gyro_kw), read_profile(profile, units=profile_units),
-                                  duration=duration, sample_rate=sample_rate, rng=rng)
-        settings.update(profile=str(profile), duration_s=duration)
+        rec, facts = _profile(model, gyro_kw, profile, profile_units, duration, sample_rate, rng, settings)
     write_recording(output, rec, units=unit,
                     header_comment=f"{_SIMULATED} --protocol {protocol}; gyro in {unit}, t in s")
     save(SimulationTruth(protocol=protocol, model=model, settings=settings, facts=facts), truth_file)
@@ -210,3 +180,52 @@ def _serve_device(protocol, speed, turns, wait, misalignment, k, b, noise, noise
         while not dev.wait(1.0):
             pass
     console.print(f"sent {dev.sent:,} bytes; the device closed the link", highlight=False)
+
+
+def _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misalignment, sample_rate, rng, settings):
+    """A servo or hand session: the recording and its facts; `settings` gains the protocol's."""
+    from ..simulation import VirtualGyro
+    from ..simulation.servo import ServoProtocol, simulate_servo
+    from ..simulation.truth import servo_facts
+
+    turn_list = tuple(t.strip() for t in turns.split(",") if t.strip())
+    kw = dict(speed=math.radians(speed), wait=wait, ramp=ramp, misalignment_deg=misalignment)
+    proto = (ServoProtocol.hand(turn_list, **kw) if protocol == "hand"
+             else ServoProtocol(turns=turn_list, vibration=vibration, **kw))
+    rec, truth = simulate_servo(VirtualGyro(model, **gyro_kw), proto, sample_rate=sample_rate, rng=rng)
+    settings.update(speed_deg_s=speed, turns=list(turn_list), wait_s=wait, ramp_s=ramp, vibration=vibration,
+                    misalignment_deg=misalignment)
+    return rec, servo_facts(truth)
+
+
+def _turntable(gyro_kw, proto, sample_rate, rng, settings):
+    """A turntable session of a gyro following the thermal truth: recording, model at 25 degC, facts."""
+    import numpy as np
+
+    from ..models import Affine
+    from ..simulation import VirtualGyro
+    from ..simulation.thermal_truth import ThermalTruth
+    from ..simulation.turntable import simulate_turntable
+
+    thermal = ThermalTruth()
+    K, B = thermal(np.array([thermal.ref_temp]))
+    model = Affine(K[0], B[0])
+    rec = simulate_turntable(VirtualGyro(model, thermal=thermal, **gyro_kw), proto, sample_rate=sample_rate, rng=rng)
+    settings.update(temps_degC=list(proto.temps), rates_deg_s=list(proto.rates), axes=list(proto.axes),
+                    step_duration_s=proto.step_duration, table_tau_s=proto.table_tau,
+                    temp_noise_degC=proto.temp_noise, temp_quantum_degC=proto.temp_quantum)
+    return rec, model, {"thermal": thermal.to_dict()}
+
+
+def _profile(model, gyro_kw, profile, profile_units, duration, sample_rate, rng, settings):
+    """A recording of a rate profile read from a CSV file."""
+    from ..io import read_profile
+    from ..simulation import VirtualGyro
+    from ..simulation.profiles import simulate_profile
+
+    if profile is None or duration is None:
+        raise InputError("--protocol profile needs --profile FILE.csv and --duration SECONDS")
+    rec, _ = simulate_profile(VirtualGyro(model, **gyro_kw), read_profile(profile, units=profile_units),
+                              duration=duration, sample_rate=sample_rate, rng=rng)
+    settings.update(profile=str(profile), duration_s=duration)
+    return rec, {}
