@@ -8,9 +8,9 @@ import re
 from pathlib import Path
 
 import typer
+from cli_runner import invoke, refused
 
 import gyrocal
-from cli_runner import invoke, refused
 from gyrocal.cli import app
 from gyrocal.cli._flags import FLAGS, NOT_FLAGS, flag
 from gyrocal.errors import ConvergenceError, FileFormatError, GyrocalError, InputError, OutOfRangeError

@@ -37,7 +37,7 @@ def test_time_not_in_seconds_under_a_plain_name_is_refused(tmp_path, rng, name, 
     g = rng.normal(0, 2.0, (50, 3))
     stamps = (1000.0 + np.arange(50) * 0.005) * per_s  # 200 Hz, stamped from boot
     write_csv(tmp_path / "r.csv", table(name, stamps, g))
-    msg = bad(tmp_path / "r.csv", re.escape(f"median time step is {step}, "))
+    msg = bad(tmp_path / "r.csv", re.escape(f"nominal time step is {step}, "))
     assert "Hz if the times are seconds" in msg and "rename it e.g. time_ms, time_us or time_ns" in msg
     # the advice works: the unit in the column's name scales the stamps to seconds
     unit = {1e3: "ms", 1e6: "us", 1e9: "ns"}[per_s]
@@ -54,7 +54,7 @@ def test_time_steps_at_the_rate_limits_pass(tmp_path, rng, rate):
 
 def test_time_slower_than_half_a_hertz_is_refused(tmp_path, rng):
     write_csv(tmp_path / "r.csv", table("t", np.arange(20) * 2.5, rng.normal(0, 2.0, (20, 3))))
-    bad(tmp_path / "r.csv", r"median time step is 2\.5, 0\.4 Hz if the times are seconds")
+    bad(tmp_path / "r.csv", r"nominal time step is 2\.5, 0\.4 Hz if the times are seconds")
 
 
 # ---------------------------------------------------------------- deg/s declared as rad/s
@@ -136,14 +136,13 @@ def test_utf16_and_utf32_text_with_a_bom_is_decoded(tmp_path, use_pyarrow, encod
 
 
 def test_cli_refuses_each_in_one_line(tmp_path, rng):
-    pytest.importorskip("typer")
     from cli_runner import refused
 
     g = rng.normal(0, 2.0, (50, 3))
     write_csv(tmp_path / "ms.csv", table("time", np.arange(50) * 5.0, g))
     (tmp_path / "nohead.csv").write_text("0,1.5,2,3\n0.01,1.5,2,3\n")
     write_csv(tmp_path / "deg.csv", table("t", np.arange(50) * 0.01, g))
-    cases = {"ms.csv": ("deg/s", "median time step is 5,"), "nohead.csv": ("deg/s", "is data, not a header; say which column"),
+    cases = {"ms.csv": ("deg/s", "nominal time step is 5,"), "nohead.csv": ("deg/s", "is data, not a header; say which column"),
              "deg.csv": ("rad/s", "per-sample noise is")}
     for name, (units, expected) in cases.items():
         line = refused("calibrate", tmp_path / name, "--units", units, "--speed", "60", "-o", tmp_path / "c.json")

@@ -30,6 +30,9 @@ from ..windows import Window
 
 __all__ = ["GUIDES", "Guide", "GuideEvent", "Step"]
 
+#: Scale factors a guided turn may imply: its measured size within 25 % of the asked one.
+_GUIDE_K_RANGE = (0.8, 1 / 0.75)
+
 
 @dataclass(frozen=True)
 class Step:
@@ -146,7 +149,8 @@ class Guide:
                         source_units=rec.source_units, sample_rate=fs, sensitivity=rec.sensitivity)
         step = self.steps[self.index]
         ref = {"reference": "speed", "speed": self.speed} if self.speed else {"reference": "angle", "angle": self.angle}
-        seg = segment(sub, require=False, **ref)
+        # a guided turn must be the asked one within 25 %: a tighter scale range than calibration's 0.45-2.2
+        seg = segment(sub, require=False, k_range=_GUIDE_K_RANGE, **ref)
         motions = sorted([*seg.rotations, *(w for w, _ in seg.ignored if w.kind == "rotation")], key=lambda w: w.stop)
         return self._judge_still(seg, n, fs, motions) if step.kind == "still" else self._judge_turn(seg, n, fs, motions)
 

@@ -84,7 +84,14 @@ def _density_to_internal(noise_density: str, noise_std: float | None, rec):
         raise InputError("give --noise-std or --noise-density, not both")
     if rec.units == "counts":
         raise InputError("--noise-density needs physical units; give --sensitivity with --units counts")
-    return noise_density_arg(noise_density) * math.sqrt(rec.sample_rate)
+    density = noise_density_arg(noise_density)
+    if not all(d > 0 for d in density):
+        axes = ", ".join(a for a, d in zip("xyz", density) if not d > 0)
+        raise InputError(f"{{param}} {noise_density} gives a zero noise density on {axes}, which would give a zero "
+                         "1-sigma (a noise file of all-zero or constant data?)", param="noise_density",
+                         value=noise_density, hint="measure the noise on a real static log (gyrocal noise), or "
+                         "leave {param} out to estimate it from the windows")
+    return density * math.sqrt(rec.sample_rate)
 
 
 def _windows_from_file(path: Optional[Path], rec):
@@ -155,6 +162,27 @@ def _print_calibration(run, truth=None) -> None:
     n_rot = sum(w.get("kind") == "rotation" for w in cal.windows)
     console.print(f"windows used: {n_rot} rotation, {len(cal.windows) - n_rot} static; found: "
                   f"{describe_found(run.segmentation.windows, run.segmentation.ignored)}", highlight=False, soft_wrap=True)
+    _print_checks(run)
+
+
+def _print_checks(run) -> None:
+    """What the self-checks found: time base, fit quality with the largest residuals, notes, warnings."""
+    for line in run.time_base.describe() if run.time_base is not None else ():
+        console.print(line, highlight=False, soft_wrap=True, markup=False)
+    q = run.quality
+    if q is None:
+        return
+    console.print(q.summary(), highlight=False, soft_wrap=True, markup=False)
+    if q.dof > 0:
+        size = [(sum(v * v for v in z) ** 0.5, i) for i, z in enumerate(q.residuals)]
+        top = sorted(size, reverse=True)[:5]
+        console.print("  largest residuals [noise sigma]: " + ", ".join(
+            f"window {i} ({q.labels[i]}) {' '.join(f'{v:+.2f}' for v in q.residuals[i])}" for _, i in top)
+            + f" ({len(size)} windows; all in the file's fit.residuals)", highlight=False, soft_wrap=True, markup=False)
+    for note in run.notes:
+        console.print(f"note: {note}", highlight=False, soft_wrap=True, markup=False)
+    for line in run.warnings:
+        warn(line)
 
 
 def _truth_calibration(path: Path, cal):
@@ -278,33 +306,41 @@ def segments(
     given = _windows_from_file(windows, rec)
     ignored: list = []
     if given is not None:
-        found, source = given, f"from {windows}"
+        from ..segmentation import standstill_level
+
+        found, source, baseline = given, f"from {windows}", standstill_level(rec, given)
     else:
         from ..segmentation import segment
 
         # Show what was found even when it is not enough to calibrate; warn after the table.
         seg = segment(rec, reference=reference, speed=speed_rad, angle=angle_rad or 2 * math.pi, require=False)
-        found, ignored, source = list(seg.windows), list(seg.ignored), "detected"
+        found, ignored, source, baseline = list(seg.windows), list(seg.ignored), "detected", seg.baseline
+    tb = rec.time_base()
+    times = tb.clock_times()
+    times = rec.t if times is None else times
     disp = "counts" if rec.units == "counts" else rate_unit
-    console.print(f"{len(found)} windows {source} in {recording.name} ({len(rec)} samples, {rec.sample_rate:.4g} Hz)",
-                  highlight=False, markup=False)
+    declared = (f"{speed:g} {rate_unit}" if reference == "speed" else f"{360.0 if angle is None else angle:g} deg")
+    console.print(f"{len(found)} windows {source} in {recording.name} ({len(rec)} samples, {rec.sample_rate:.4g} Hz); "
+                  f"declared {reference} {declared}; angles and rates below are measured (raw readings, standstill "
+                  "level removed, before calibration)", highlight=False, markup=False, soft_wrap=True)
+    for line in tb.describe():
+        console.print(line, highlight=False, markup=False, soft_wrap=True)
+    angle_unit = "counts s" if rec.units == "counts" else "deg"
     table = Table()
-    for col in ("#", "kind", "turn", "start", "stop", "t0 [s]", "length [s]", "angle [deg]", f"mean rate [{disp}]"):
+    for col in ("#", "kind", "turn", "start", "stop", "t0 [s]", "length [s]", f"angle [{angle_unit}]",
+                f"mean rate [{disp}]"):
         table.add_column(escape(col), justify="right" if col not in ("kind", "turn") else "left")
     for i, w in enumerate(found):
-        turn = "" if w.kind == "static" else f"{'+' if w.sign > 0 else '-' if w.sign < 0 else ''}{w.axis or '?'}"
-        rate = "" if math.isnan(w.rate) else f"{_rate_display(w.rate, rec, disp):.4g}"
-        ang = "" if math.isnan(w.angle) else f"{math.degrees(w.angle):.1f}"
-        table.add_row(str(i), w.kind, turn, str(w.start), str(w.stop), f"{rec.t[w.start]:.2f}",
-                      f"{(w.stop - w.start) / rec.sample_rate:.2f}", ang, rate)
+        table.add_row(str(i), w.kind, _turn(w), str(w.start), str(w.stop), f"{rec.t[w.start]:.2f}",
+                      f"{times[w.stop - 1] - times[w.start]:.2f}", *_measured(rec, w, baseline, times, disp))
     console.print(table)
     if ignored:
         console.print(f"{len(ignored)} ignored:")
         skipped = Table()
-        for col in ("start", "stop", "why"):
-            skipped.add_column(col)
+        for col in ("start", "stop", "turn", f"angle [{angle_unit}]", f"mean rate [{disp}]", "why"):
+            skipped.add_column(escape(col), justify="left" if col in ("turn", "why") else "right")
         for w, why in ignored:
-            skipped.add_row(str(w.start), str(w.stop), why)
+            skipped.add_row(str(w.start), str(w.stop), _turn(w), *_measured(rec, w, baseline, times, disp), why)
         console.print(skipped)
     else:
         console.print("nothing ignored")
@@ -321,8 +357,18 @@ def segments(
         console.print(f"wrote {plot}", highlight=False)
 
 
-def _rate_display(rate: float, rec, unit: str) -> float:
-    """A window's mean rate [internal units] in the display unit."""
+def _turn(w) -> str:
+    return "" if w.kind == "static" else f"{'+' if w.sign > 0 else '-' if w.sign < 0 else ''}{w.axis or '?'}"
+
+
+def _measured(rec, w, baseline, times, unit: str) -> tuple[str, str]:
+    """A rotation window's measured angle and mean rate, as printed (blank for a static window)."""
+    from ..segmentation import measure_turn
     from ..units import from_rad_s
 
-    return rate if rec.units == "counts" else float(from_rad_s(rate, unit))
+    if w.kind == "static":
+        return "", ""
+    angle, rate = measure_turn(rec, w, baseline, times)
+    if rec.units == "counts":
+        return f"{angle:.4g}", f"{rate:.4g}"
+    return f"{math.degrees(angle):.1f}", f"{float(from_rad_s(rate, unit)):.4g}"

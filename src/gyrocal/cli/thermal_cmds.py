@@ -99,10 +99,10 @@ def thermal(
 def _print_table(cal, fit) -> None:
     import numpy as np
     from rich.box import SIMPLE
-
-    from ..units import unit_factor
     from rich.markup import escape
     from rich.table import Table
+
+    from ..units import unit_factor
 
     user = cal.kg_user
     std = cal.to_user(cal.std)  # 1-sigma in the table's units; below, the largest of each group of terms
@@ -148,7 +148,7 @@ def thermal_report(
     """Compare uncompensated, traditional, Lagrange and smooth compensation on a test recording."""
     from ..files import load_thermal
     from ..thermal.evaluate import evaluate
-    from ..thermal.report import write_report
+    from ..thermal_report import write_report
 
     check_output(output, inputs=(calibration, test), folder=True)
     cal = load_thermal(calibration)

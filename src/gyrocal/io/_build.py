@@ -10,10 +10,10 @@ from .._validation import positive
 from ..choices import AccelUnit, SaturationPolicy, values
 from ..errors import InputError, NonFiniteInputError, SaturationError, UnitError
 from ..recording import Recording
+from ..saturation import find_saturation, stuck_runs
+from ..timebase import nominal_period
 from ..units import parse_input_unit, parse_rate_unit, unit_factor
 from ._columns import ACCEL, NUMERIC
-from ..saturation import find_saturation, stuck_runs
-
 
 #: No MEMS gyro measures beyond about 2000 deg/s (4000 for a few); above this, rad/s is a unit mistake.
 MAX_PLAUSIBLE_RAD_S = math.radians(2000.0)
@@ -47,7 +47,7 @@ def _check_finite(data: dict, source: str, known_finite: tuple[str, ...] = ()) -
 
 
 def _check_time(t: np.ndarray, source: str) -> float:
-    """Check that time increases; return the nominal rate (median step) [Hz]."""
+    """Check that time increases; return the nominal rate [Hz] (:func:`gyrocal.timebase.nominal_period`)."""
     increasing = t[1:] > t[:-1]
     if not increasing.all():
         i = int(np.argmin(increasing))
@@ -57,19 +57,15 @@ def _check_time(t: np.ndarray, source: str) -> float:
             f"{source}: {what} at data row {i + 2} (t={float(t[i])} then {float(t[i + 1])}); "
             "times must increase strictly: sort the log and drop repeated rows"
         )
-    # up to 100 000 evenly spread steps: nominal, and cheap on long logs. Their median, refined by the mean
-    # of the steps near it: stamps at epoch seconds (1.7e9 s) come in multiples of 0.24 us, so a 200 Hz
-    # step reads 4.99988 or 5.00012 ms and the median alone would pick one of them.
-    i = np.linspace(0, len(t) - 2, min(len(t) - 1, 100_000)).astype(np.intp)
-    steps = t[i + 1] - t[i]
-    step = float(np.median(steps))
-    step = float(np.mean(steps[np.abs(steps - step) <= 1e-3 * step]))
+    # the mean step of the sensor clock, robust to gaps (gyrocal.timebase): never the median step of bursty
+    # receive-time stamps, and block means of 64 steps average away the 0.24 us quantum of epoch stamps
+    step = nominal_period(t)
     fs = 1.0 / step
     # ms or ns stamps under a plain name (t, time, timestamp) read as seconds; the 1e-6 slack
     # lets stamps at exactly 0.5 Hz or 100 kHz through despite rounding
     if not MIN_SAMPLE_RATE * (1 - 1e-6) <= fs <= MAX_SAMPLE_RATE * (1 + 1e-6):
         raise InputError(
-            f"{source}: the median time step is {step:.6g}, {fs:.3g} Hz if the times are seconds, "
+            f"{source}: the nominal time step is {step:.6g}, {fs:.3g} Hz if the times are seconds, "
             "outside the 0.5 Hz-100 kHz of a gyro; times in ms, us or ns need the unit in the column's name: "
             "rename it e.g. time_ms, time_us or time_ns"
         )
