@@ -75,7 +75,7 @@ def test_turn_about_another_axis_is_refused():
 
 def test_hand_session_with_a_redo():
     rng = np.random.default_rng(163)
-    proto = ServoProtocol.hand(turns=("+x", "+y", "+y", "+z"), lead_in=3.0, wait=3.0, lead_out=3.0)
+    proto = ServoProtocol.hand(turns=("+x", "+y", "+y", "+z"), lead_in=3.0, wait=4.0, lead_out=4.0)
     s = simulate_device_session(proto, model=MODEL, noise_std=0.01, rng=rng)
     guide = Guide("hand")
     # after the first +y is accepted the person asks to redo it, and does it again
