@@ -2,7 +2,7 @@
 
 Run by hand:  python bench/bench_pipeline.py [--samples 10000000] [--repeat 3]
 
-Simulates a long servo session (seed 000's six turns at 60 deg/s, ramps, vibration,
+Simulates a long servo session (the servo method's six turns at 60 deg/s, ramps, vibration,
 5 deg misalignment, MPU9250 errors of Table III, repeated) at 1 kHz, writes it as a
 CSV ``t, gx, gy, gz`` in deg/s to a temporary folder, then times in the same process:
 

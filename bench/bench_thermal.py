@@ -1,4 +1,4 @@
-"""Benchmark: fit a paper-size seed 001 session (10 temperatures x 3 positions x 21 rates).
+"""Benchmark: fit a paper-size session of the full-temperature-range method (10 temperatures x 3 positions x 21 rates).
 
 Run by hand:  python bench/bench_thermal.py [--step-duration 60] [--sample-rate 200]
 
@@ -20,7 +20,8 @@ import numpy as np
 from gyrocal.io import write_csv
 from gyrocal.simulation.thermal_truth import ThermalTruth
 from gyrocal.simulation.turntable import TurntableProtocol, simulate_turntable
-from gyrocal.thermal import calibrate_thermal, read_session
+from gyrocal.io import read_session
+from gyrocal.thermal import calibrate_thermal
 from gyrocal.thermal.fit import kg_eq19
 
 

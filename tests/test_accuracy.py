@@ -1,4 +1,4 @@
-"""Accuracy at seed 000's normal simulation conditions (issue 2, "what it must reach").
+"""Accuracy at the servo method's normal simulation conditions (issue 2, "what it must reach").
 
 2,000 seeded gyros: k ~ U(0.8, 1.2), b ~ U(-0.1, 0.1) rad/s, 200 Hz, 60 deg/s, 0.035 rad/s
 noise, 5 % speed jitter, tilts up to 0.1 rad, one revolution per window.

@@ -40,7 +40,7 @@ def _within_4_sigma(cal, truth=TRUE):
 
 @pytest.fixture(scope="module")
 def servo_csv(tmp_path_factory):
-    """Seed 000's protocol at 60 deg/s, 200 Hz, ramps and vibration, 5 deg misaligned, in deg/s."""
+    """The servo method's protocol at 60 deg/s, 200 Hz, ramps and vibration, 5 deg misaligned, in deg/s."""
     rng = np.random.default_rng(3)
     rec, truth = _simulate(rng, ServoProtocol(misalignment_deg=5.0))
     path = tmp_path_factory.mktemp("servo") / "rec.csv"
@@ -314,7 +314,8 @@ def test_example_uncertainty_matches_monte_carlo_within_20_percent(tmp_path):
 def thermal_file(tmp_path):
     """A thermal table whose bias grows 0.01 deg/s per degC, with a 1 % x scale error."""
     from gyrocal.models import Affine
-    from gyrocal.thermal import ThermalCalibration, fit_smooth, save_thermal
+    from gyrocal.files import save_thermal
+    from gyrocal.thermal import ThermalCalibration, fit_smooth
 
     temps = np.array([-10.0, 10.0, 30.0, 50.0])
     K = np.diag([1.01, 1.0, 1.0])

@@ -22,7 +22,7 @@ from gyrocal.models import ScaleBias
 from gyrocal.observations import ObservationSet
 from gyrocal.simulation.windows import PAPER_AXES, paper_observations
 
-SPEED = math.pi / 3  # 60 deg/s, seed 000 section III-A
+SPEED = math.pi / 3  # 60 deg/s, the servo method of Wang et al., section III-A
 SIGMA = 0.035
 
 

@@ -69,7 +69,7 @@ def solution_tolerance(k, b, S, M, Y) -> np.ndarray:
 
 
 def simulated(rng, n_gyros: int = 4) -> tuple[ObservationSet, np.ndarray, np.ndarray]:
-    """Seed 000's simulation settings (section III-A), per sample, for a few random gyros."""
+    """The servo method's simulation settings (section III-A), per sample, for a few random gyros."""
     k = rng.uniform(0.8, 1.2, (n_gyros, 3))
     b = rng.uniform(-0.1, 0.1, (n_gyros, 3))
     return paper_observations(k, b, speed=np.pi / 3, rng=rng), k, b
@@ -82,7 +82,7 @@ def test_algorithm1_matches_python(clib, rng):
         k, b, iterations = clib.algorithm1(obs.mean_sq[i], obs.mean[i], obs.rate[i])
         tol = solution_tolerance(ref.k[i], ref.b[i], obs.mean_sq[i], obs.mean[i], obs.rate[i] ** 2)
         assert np.all(np.abs(np.concatenate([k, b]) - ref.params[i]) <= tol)
-        assert 1 <= iterations <= 10  # seed 000, Table I: a handful
+        assert 1 <= iterations <= 10  # the servo method of Wang et al., Table I: a handful
 
 
 def test_first_moment_matches_python(clib, rng):
@@ -239,7 +239,7 @@ def test_correction_matches_python_on_real_session(clib, session, session_calibr
     gyro, _ = session
     matrix, offset = session_calibration.correction
     out = clib.correct(matrix, offset, gyro)
-    ref = session_calibration.apply(gyro)
+    ref = session_calibration.correct(gyro)
     assert np.all(np.abs(out - ref) <= correction_tolerance(matrix, offset, gyro))
 
 
@@ -251,7 +251,7 @@ def test_affine_correction_matches_python(clib, rng):
 
 
 def thermal_table(rng, units: str = "deg/s") -> ThermalCalibration:
-    """Seed 001 Table 1 temperatures; Kg a smooth trend around an identity-like gyro plus fit noise."""
+    """The full-temperature-range method, Table 1 temperatures; Kg a smooth trend around an identity-like gyro plus fit noise."""
     temps = np.arange(-40.0, 51.0, 10.0)
     u = (temps[:, None] - 5.0) / 45.0
     base = np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
@@ -261,7 +261,7 @@ def thermal_table(rng, units: str = "deg/s") -> ThermalCalibration:
 
 
 def _k_matrix(v9: np.ndarray) -> np.ndarray:
-    """K (..., 3, 3) from the first nine Kg elements (seed 001, eq. 11)."""
+    """K (..., 3, 3) from the first nine Kg elements (the full-temperature-range method, eq. 11)."""
     K = np.zeros(v9.shape[:-1] + (3, 3))
     for e, (row, col) in enumerate(KG_INDEX):
         K[..., row, col] = v9[..., e]
@@ -358,7 +358,7 @@ def _literals(text: str, name: str) -> np.ndarray:
 
 def test_c_header_is_read_by_the_library(clib, tmp_path, session, session_calibration):
     gyro, _ = session
-    text = firmware.c_header(session_calibration)
+    text = session_calibration.c_header()
     dll = _build_driver(tmp_path, text, DRIVER, "gyrocal_calibration")
     raw = np.ascontiguousarray(gyro[::50], dtype=np.float32)
     out = np.empty_like(raw)
@@ -366,12 +366,12 @@ def test_c_header_is_read_by_the_library(clib, tmp_path, session, session_calibr
     for i in range(len(raw)):
         dll.apply_header(raw[i].ctypes.data_as(fptr), out[i].ctypes.data_as(fptr))
     matrix, offset = session_calibration.correction
-    ref = session_calibration.apply(raw.astype(float))
+    ref = session_calibration.correct(raw.astype(float))
     assert np.all(np.abs(out - ref) <= correction_tolerance(matrix, offset, raw))
 
 
 def test_c_header_documents_convention_units_parameters_and_provenance(session_calibration):
-    text = firmware.c_header(session_calibration)
+    text = session_calibration.c_header()
     comment = text[: text.index("*/")]
     assert "w_true = matrix @ (raw - offset)" in comment
     assert "raw and offset in deg/s" in comment and "w_true in deg/s" in comment
@@ -388,14 +388,14 @@ def test_c_header_documents_convention_units_parameters_and_provenance(session_c
 
 def test_c_header_without_covariance_says_so():
     cal = Calibration(ScaleBias(k=[1.0, 1.01, 0.99], b=[0.01, 0.0, -0.02]), method="algorithm1")
-    text = firmware.c_header(cal)
+    text = cal.c_header()
     assert text.count("not estimated") == 6
     assert "rad/s" in text
 
 
 def test_thermal_header_is_read_by_the_library(clib, tmp_path, rng):
     tc = thermal_table(rng)
-    text = firmware.thermal_c_header(tc)
+    text = tc.c_header()
     assert "Kxx, Kyy, Kzz, Kyx, Kzx, Kxy, Kzy, Kxz, Kyz, Bx, By, Bz" in text
     assert "s = clamp(i - 2, 0, n - 3)" in text
     dll = _build_driver(tmp_path, text, THERMAL_DRIVER, "gyrocal_thermal")
@@ -417,9 +417,37 @@ def test_thermal_header_refuses_a_short_table():
         temps = np.array([0.0, 10.0])
         kg_user = np.zeros((2, 12))
         input_units = output_units = "deg/s"
+        range = (0.0, 10.0)
+        temp_tau = 0.0
 
     with pytest.raises(InputError, match="at least|>= 3"):
-        firmware.thermal_c_header(Table())
+        firmware.thermal_header(Table())
+
+
+def test_headers_carry_their_prefix_and_check_the_library_version(clib, tmp_path, rng):
+    """Two sensors' tables in one translation unit compile side by side; a header made for another
+    library version stops the build. Reference: the C compiler itself, and gyrocal_cal.h's own macro."""
+    header = (firmware.c_source_dir() / "gyrocal_cal.h").read_text()
+    version = re.search(r"#define GYROCAL_CAL_VERSION (\d+)", header)
+    assert version is not None and int(version.group(1)) == firmware.C_LIBRARY_VERSION
+    tc = thermal_table(rng)
+    cal = Calibration(ScaleBias(k=[1.0, 1.01, 0.99], b=[0.01, 0.0, -0.02]), "deg/s", "deg/s")
+    (tmp_path / "imu1.h").write_text(cal.c_header(prefix="imu1"))
+    (tmp_path / "imu2.h").write_text(cal.c_header(prefix="imu2"))
+    (tmp_path / "imu2_thermal.h").write_text(tc.c_header(prefix="imu2"))
+    driver = tmp_path / "two.c"
+    driver.write_text('#include "imu1.h"\n#include "imu2.h"\n#include "imu2_thermal.h"\n'
+                      "void both(const float raw[3], float a[3], float b[3])\n"
+                      "{ gyrocal_correct(&IMU1_CALIBRATION, raw, a); gyrocal_correct(&IMU2_CALIBRATION, raw, b); }\n"
+                      "int n2(void) { return IMU2_THERMAL_N; }\n")
+    dll = firmware.load_library(tmp_path / "build", extra_sources=[driver], include_dirs=[tmp_path]).dll
+    assert dll.n2() == len(tc.temps)
+    stale = cal.c_header(prefix="old").replace("#define OLD_CALIBRATION_LIB_VERSION 2",
+                                               "#define OLD_CALIBRATION_LIB_VERSION 1")
+    (tmp_path / "old.h").write_text(stale)
+    (tmp_path / "old.c").write_text('#include "old.h"\nint unused_old(void) { return 0; }\n')
+    with pytest.raises(firmware.CCompileError, match="written for gyrocal_cal.h version"):
+        firmware.load_library(tmp_path / "build2", extra_sources=[tmp_path / "old.c"], include_dirs=[tmp_path])
 
 
 def test_library_source_uses_nothing_beyond_math_h():

@@ -17,7 +17,7 @@ import pytest
 imucal = pytest.importorskip("imucal")
 pd = pytest.importorskip("pandas")
 
-from gyrocal.calibration import load_calibration
+from gyrocal.files import load_calibration
 from gyrocal.cli.app import run
 
 DATA = Path(str(resources.files("gyrocal") / "data" / "imucal_ferraris"))
@@ -65,7 +65,7 @@ def test_scale_agrees_with_imucal_within_one_percent(gyrocal_cal, imucal_gyro):
 
 
 def test_bias_agrees_with_imucal_within_005_dps(gyrocal_cal, imucal_gyro):
-    _, offset = gyrocal_cal.correction  # deg/s, the zero-rate offset (= -b of seed 000)
+    _, offset = gyrocal_cal.correction  # deg/s, the zero-rate offset (= -b of the servo method of Wang et al.)
     assert np.all(np.abs(offset - imucal_gyro["bias"]) < 0.05)
 
 

@@ -97,11 +97,16 @@ def test_slow_deg_s_data_declared_as_rad_s_are_caught_by_their_noise(tmp_path, r
 
 
 @pytest.mark.parametrize(("delimiter", "example"), [(",", "'t,gx,gy,gz'"), (" ", "'t gx gy gz'")])
-def test_headerless_file_asks_for_a_header_row(tmp_path, delimiter, example):
+def test_headerless_file_asks_for_columns_by_number(tmp_path, delimiter, example):
     rows = ["0 -0.21 0.05 0.33", "0.01 -0.2 0.04 0.31", "0.02 -0.22 0.06 0.3"]
     (tmp_path / "h.csv").write_text("\n".join(r.replace(" ", delimiter) for r in rows) + "\n")
-    msg = bad(tmp_path / "h.csv", r"the first line \('0.-0\.21.*'\) is data, not a header; add a header row")
+    msg = bad(tmp_path / "h.csv", r"the first line \('0.-0\.21.*'\) is data, not a header; say which column holds "
+              r"what by number, counting from 1 \(--columns t=1,gx=2,gy=3,gz=4\)")
     assert example in msg
+    # the advice works: the first column increases, so it is offered as the time
+    rec = read_recording(tmp_path / "h.csv", units="deg/s", columns="t=1,gx=2,gy=3,gz=4")
+    np.testing.assert_array_equal(rec.t, [0.0, 0.01, 0.02])
+    np.testing.assert_allclose(np.degrees(rec.gyro[:, 0]), [-0.21, -0.2, -0.22], rtol=1e-12)
 
 
 @pytest.mark.parametrize("use_pyarrow", [True, False])
@@ -136,17 +141,22 @@ def test_cli_refuses_each_in_one_line(tmp_path, rng):
 
     g = rng.normal(0, 2.0, (50, 3))
     write_csv(tmp_path / "ms.csv", table("time", np.arange(50) * 5.0, g))
-    (tmp_path / "nohead.csv").write_text("0,1,2,3\n0.01,1,2,3\n")
+    (tmp_path / "nohead.csv").write_text("0,1.5,2,3\n0.01,1.5,2,3\n")
     write_csv(tmp_path / "deg.csv", table("t", np.arange(50) * 0.01, g))
-    cases = {"ms.csv": ("deg/s", "median time step is 5,"), "nohead.csv": ("deg/s", "is data, not a header"),
+    cases = {"ms.csv": ("deg/s", "median time step is 5,"), "nohead.csv": ("deg/s", "is data, not a header; say which column"),
              "deg.csv": ("rad/s", "per-sample noise is")}
     for name, (units, expected) in cases.items():
         line = refused("calibrate", tmp_path / name, "--units", units, "--speed", "60", "-o", tmp_path / "c.json")
         assert expected in line, line
 
 
-def test_numeric_header_names_are_a_header_when_mapped(tmp_path):
+def test_numbered_header_of_pandas_is_a_header_and_its_names_win_over_positions(tmp_path):
     path = tmp_path / "frame.csv"
     path.write_text("0,1,2,3\n" + "".join(f"{i / 100},{0.1 * i},0.2,0.3\n" for i in range(50)))
     rec = read_recording(path, units="deg/s", columns="t=0,gx=1,gy=2,gz=3")
     assert len(rec) == 50 and rec.sample_rate == pytest.approx(100.0)
+    np.testing.assert_allclose(np.degrees(rec.gyro[:3, 0]), [0.0, 0.1, 0.2], rtol=1e-12)
+    bad(path, r"the header \('0,1,2,3'\) numbers the columns from 0, as pandas writes them; say which column holds "
+        r"what by those names, e.g. --columns t=0,gx=1,gy=2,gz=3")
+    # positions counted from 1 would collide with the names: refused, never read shifted
+    bad(path, r"column '3' is given for both gy and gz", columns="t=1,gx=2,gy=3,gz=4")

@@ -33,7 +33,7 @@ def test_canonical_round_trip_is_exact(make, rng):
     np.testing.assert_array_equal(type(model).from_params(model.params).params, model.params)
 
 
-def test_scale_bias_matches_seed000_eq1(rng):
+def test_scale_bias_matches_wang_eq1(rng):
     model = random_scale_bias(rng)
     m = rng.normal(0, 1, (10, 3))
     np.testing.assert_allclose(model.correct(m), (m + model.b) * model.k, rtol=1e-15)
@@ -50,7 +50,7 @@ def test_scale_bias_to_affine_is_the_same_map(rng):
     np.testing.assert_allclose(aff.B, -model.b, rtol=1e-15)
 
 
-def test_kg_order_follows_seed001_eq15():
+def test_kg_order_follows_full_temperature_range_eq15():
     # eq. 15, first row of Omega^T: wx = Kxx w~x + Kyx w~y + Kzx w~z + Bx
     kg = np.arange(1.0, 13.0) + np.array([10, 20, 30, 0, 0, 0, 0, 0, 0, 0, 0, 0])  # well-conditioned K
     aff = Affine.from_kg(kg)

@@ -109,7 +109,7 @@ def test_too_short_record_is_refused():
 
 
 def test_allan_plot_draws_every_axis(report):
-    from gyrocal.plotting._mpl import new_figure
+    from gyrocal.plotting import new_figure
     from gyrocal.plotting.noise import allan_deviation_plot
 
     fig = new_figure()

@@ -1,4 +1,4 @@
-"""Window reductions and the reference per-sample simulation of seed 000's protocol."""
+"""Window reductions and the reference per-sample simulation of the servo method's protocol."""
 
 import math
 

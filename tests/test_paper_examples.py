@@ -1,4 +1,4 @@
-"""Seed 000's worked example (section III-A) and the three Table I cases.
+"""The servo method's worked example (section III-A) and the three Table I cases.
 
 Each case is simulated 200 times at the paper's normal conditions (200 Hz, 60 deg/s,
 0.035 rad/s, 5 % jitter, tilts up to 0.1 rad). Table I's convergence behaviour is

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from gyrocal.calibration import load_calibration, save_calibration
+from gyrocal.files import load_calibration, save_calibration
 from gyrocal.errors import InputError, SegmentationError
 from gyrocal.models import ScaleBias
 from gyrocal.pipeline import CalibrationRun, calibrate
@@ -15,7 +15,7 @@ from gyrocal.simulation import VirtualGyro
 from gyrocal.simulation.servo import PAPER_TURNS, ServoProtocol, simulate_servo
 from gyrocal.windows import Window
 
-K = np.array([1.0069, 0.9960, 0.9955])  # seed 000, Table III (MPU9250)
+K = np.array([1.0069, 0.9960, 0.9955])  # the servo method of Wang et al., Table III (MPU9250)
 B = np.array([0.0442, -0.0089, 0.0076])  # [rad/s]
 TRUE = np.concatenate([K, B])
 GYRO = VirtualGyro(ScaleBias(K, B), noise_std=0.035)

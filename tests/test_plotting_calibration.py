@@ -10,7 +10,7 @@ pytest.importorskip("matplotlib")
 from matplotlib.figure import Figure
 
 from gyrocal import Calibration, Recording, ScaleBias
-from gyrocal.plotting._mpl import new_figure, save_figure
+from gyrocal.plotting import new_figure, save_figure
 from gyrocal.plotting.calibration import calibration_figure, plot_corrected, plot_windows
 from gyrocal.windows import Window
 

@@ -17,7 +17,7 @@ from gyrocal.segmentation import Segmentation, segment
 from gyrocal.simulation import VirtualGyro
 from gyrocal.simulation.servo import PAPER_TURNS, ServoProtocol, simulate_servo
 
-MPU9250 = ScaleBias(k=[1.0069, 0.9960, 0.9955], b=[0.0442, -0.0089, 0.0076])  # seed 000, Table III
+MPU9250 = ScaleBias(k=[1.0069, 0.9960, 0.9955], b=[0.0442, -0.0089, 0.0076])  # the servo method of Wang et al., Table III
 GYRO = VirtualGyro(MPU9250, noise_std=0.035)
 FS = 200.0
 SPEED = math.radians(60.0)

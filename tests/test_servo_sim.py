@@ -10,7 +10,7 @@ from gyrocal.models import ScaleBias
 from gyrocal.simulation import VirtualGyro
 from gyrocal.simulation.servo import PAPER_TURNS, ServoProtocol, simulate_servo
 
-# Seed 000, Table III (MPU9250).
+# The servo method of Wang et al., Table III (MPU9250).
 MPU9250 = ScaleBias(k=[1.0069, 0.9960, 0.9955], b=[0.0442, -0.0089, 0.0076])
 FS = 200.0
 

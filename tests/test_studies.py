@@ -44,7 +44,7 @@ def test_first_moment_reaches_the_cramer_rao_bound(normal):
 
 
 def test_algorithm1_equals_lm_with_six_observations(normal):
-    """Six equations fix six unknowns, so both solvers land on the same point (seed 000, Fig. 2)."""
+    """Six equations fix six unknowns, so both solvers land on the same point (the servo method of Wang et al., Fig. 2)."""
     out, _, _ = normal
     rows = _rows(out / "errors.csv")
     alg = {(r["noise [rad/s]"], r["param"]): float(r["rms"]) for r in rows if r["method"] == "Algorithm 1"}
@@ -114,7 +114,7 @@ def test_run_study_rejects_bad_arguments(tmp_path):
 
 
 def test_study_plots_draw_their_artists():
-    from gyrocal.plotting._mpl import new_figure
+    from gyrocal.plotting import new_figure
     from gyrocal.plotting.studies import convergence, error_boxes, mse_vs_speed, rms_by_temperature
 
     fig = new_figure()

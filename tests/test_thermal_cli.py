@@ -90,7 +90,7 @@ def test_installed_entry_point(files, tmp_path):
     proc = subprocess.run([str(exe), "thermal", str(files["session"]), "--units", "deg/s", "-o", str(out),
                            "--full-scale", "300", "--settle", "1"], capture_output=True, text=True, timeout=120, check=False)
     assert proc.returncode == 0, proc.stderr
-    assert json.loads(out.read_text())["version"] == 1
+    assert json.loads(out.read_text())["version"] == 2
 
 
 def test_report_outside_the_calibrated_range_names_the_flag(files, tmp_path, capsys):
@@ -102,7 +102,7 @@ def test_report_outside_the_calibrated_range_names_the_flag(files, tmp_path, cap
     out.write_text(json.dumps(doc))
     assert run(["thermal-report", str(out), str(files["test"]), "-o", str(tmp_path / "r"), "--no-figures",
                 "--settle", "1", "--full-scale", "300"]) == 2
-    assert "-15.00 degC; pass --out-of-range 'clamp'" in capsys.readouterr().err
+    assert "-15.00 degC; set --out-of-range to 'clamp'" in capsys.readouterr().err
 
 
 def test_thermal_output_is_replaced_only_when_the_same_or_forced(files, tmp_path, capsys):

@@ -1,4 +1,4 @@
-"""Evaluation like seed 001's Tables 3-4 and Figures 4-9, the report folder, and the figures."""
+"""Evaluation like the full-temperature-range method's Tables 3-4 and Figures 4-9, the report folder, and the figures."""
 
 import dataclasses
 
@@ -77,7 +77,7 @@ def test_markdown_table():
 
 
 def test_figures_draw_the_expected_artists(calibrated):
-    from gyrocal.plotting._mpl import new_figure
+    from gyrocal.plotting import new_figure
     from gyrocal.plotting.thermal import plot_coefficients, plot_error_vs_rate, plot_error_vs_temperature
 
     truth, cal, ev = calibrated

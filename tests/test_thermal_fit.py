@@ -1,4 +1,4 @@
-"""Per-temperature 12-parameter least squares (seed 001 eq. 15-19) against simulated truth."""
+"""Per-temperature 12-parameter least squares (the full-temperature-range method, eq. 15-19) against simulated truth."""
 
 import numpy as np
 import pytest
@@ -21,7 +21,7 @@ def _session(rng, noise=NOISE, **protocol):
 def test_omega_first_row_is_eq15():
     om = omega_matrix(np.array([[2.0, 3.0, 5.0]]))
     kg = np.arange(1.0, 13.0)
-    # wx = Kxx w~x + Kyx w~y + Kzx w~z + Bx (seed 001 eq. 15, first row of Omega^T)
+    # wx = Kxx w~x + Kyx w~y + Kzx w~z + Bx (the full-temperature-range method, eq. 15, first row of Omega^T)
     assert (kg @ om)[0] == pytest.approx(1 * 2 + 4 * 3 + 5 * 5 + 10)
 
 

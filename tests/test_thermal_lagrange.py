@@ -1,4 +1,4 @@
-"""3-node Lagrange interpolation (seed 001 eq. 21-22) and its stencil and range rules."""
+"""3-node Lagrange interpolation (the full-temperature-range method, eq. 21-22) and its stencil and range rules."""
 
 import warnings
 

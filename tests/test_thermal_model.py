@@ -1,4 +1,5 @@
-"""The temperature table: units, file round trip, compensation, smoothing of temperature, smooth model."""
+"""The temperature table: units, file round trip (format version 2, docs/files.md), compensation, smoothing of
+temperature, smooth model. References: ThermalTruth (the simulated true Kg) and the canonical correction."""
 
 import json
 
@@ -13,11 +14,10 @@ from gyrocal.thermal import (
     ThermalCalibration,
     ThermalRangeWarning,
     fit_smooth,
-    load_thermal,
-    save_thermal,
     smooth_temperature,
 )
-from gyrocal.thermal.model import kg_to_kb
+from gyrocal.files import load_thermal, save_thermal
+from gyrocal.models import kg_to_kb
 
 TEMPS = np.array([-40.0, -30, -20, -10, 0, 10, 20, 30, 40, 50])
 TRUTH = ThermalTruth()
@@ -47,13 +47,13 @@ def test_file_round_trip(tmp_path):
     np.testing.assert_array_equal(back.smooth.coefs, cal.smooth.coefs)
     assert (back.input_units, back.output_units, back.reference_temp, back.range) == ("deg/s", "rad/s", 20.0, (-40, 50))
     doc = json.loads((tmp_path / "t.json").read_text())
-    assert doc["format"] == "gyrocal.thermal" and doc["version"] == 1
-    assert doc["kg_names"][:4] == ["Kxx", "Kyy", "Kzz", "Kyx"]
+    assert doc["format"] == "gyrocal.thermal" and doc["version"] == 2
+    assert doc["kg_order"][:4] == ["Kxx", "Kyy", "Kzz", "Kyx"] and doc["fit"] is None
     np.testing.assert_allclose(doc["points"][0]["kg_user"], cal.kg_user[0])
 
 
 @pytest.mark.parametrize(("field", "value", "match"), [
-    ("version", 7, "version"), ("format", "gyrocal.calibration", "format"), ("kg_names", ["a"], "kg_names")])
+    ("version", 7, "version"), ("format", "gyrocal.calibration", "format"), ("kg_order", ["a"], "kg_order")])
 def test_bad_file_names_the_field(tmp_path, field, value, match):
     save_thermal(_cal(), tmp_path / "t.json")
     doc = json.loads((tmp_path / "t.json").read_text())
@@ -92,8 +92,9 @@ def test_apply_recovers_true_rates_at_calibrated_and_between_temperatures():
     true = np.tile(np.radians([[100.0, -50.0, 10.0]]), (n, 1))
     for temp in (-40.0, 25.0, 47.0):
         out = cal.apply(_recording(true, np.full(n, temp)))
+        assert out.source_units == "deg/s" and out.units == "rad/s"
         # cubic bias between nodes: Lagrange error stays far below 1e-3 deg/s here
-        np.testing.assert_allclose(out, np.degrees(true), atol=2e-3)
+        np.testing.assert_allclose(np.degrees(out.gyro), np.degrees(true), atol=2e-3)
 
 
 def test_apply_without_temp_is_an_error():
@@ -121,8 +122,8 @@ def test_quantised_temperature_does_not_make_the_output_jump():
     read = np.round(true_temp)  # 1 degC quantisation
     true = np.tile(np.radians([[400.0, 0.0, 0.0]]), (n, 1))
     rec = _recording(true, read, truth_temp=true_temp, fs=fs)
-    jumpy = cal.apply(rec, temp_tau=0.0)
-    smooth = cal.apply(rec)
+    jumpy = cal.apply(rec, temp_tau=0.0).gyro
+    smooth = cal.apply(rec).gyro
     step = np.max(np.abs(np.diff(jumpy, axis=0)))
     noise = np.radians(0.05)  # a typical per-sample noise
     assert step > noise / 10  # without smoothing the 1 degC step shows

@@ -13,9 +13,9 @@ from gyrocal.thermal import (
     SaturatedStepsWarning,
     calibrate_thermal,
     find_steps,
-    read_session,
     session_steps,
 )
+from gyrocal.io import read_session
 
 NOISE = np.radians(0.05)
 FAST = {"step_duration": 3.0, "rates": (0.0, 10.0, 100.0, 400.0)}

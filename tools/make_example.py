@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
 """Regenerate the bundled example recording ``src/gyrocal/data/example_servo.csv``.
 
-The gyro is the MPU9250 of seed 000, Table III (k = 1.0069, 0.9960, 0.9955;
+The gyro is the MPU9250 of the servo method of Wang et al., Table III (k = 1.0069, 0.9960, 0.9955;
 b = 0.0442, -0.0089, 0.0076 rad/s) with the paper's simulated white noise
 (0.035 rad/s per sample), read at 200 Hz and quantised to the MPU9250's
-+-250 deg/s range (131 LSB per deg/s). The motion is seed 000's protocol (Fig. 1):
++-250 deg/s range (131 LSB per deg/s). The motion is that paper's protocol (Fig. 1):
 360 deg clockwise and counter-clockwise about x, y and z at 60 deg/s, 3 s apart,
 with 0.3 s speed ramps, 5 % servo vibration and a 5 deg mounting misalignment.
 
@@ -13,8 +13,8 @@ Usage::
     python tools/make_example.py            # writes the CSV and its truth sidecar
     python tools/make_example.py --check    # regenerates in memory and compares
 
-The sidecar ``example_servo.truth.json`` holds the true parameters, the mounting
-rotation and the true windows. The run is seeded, so the output is reproducible.
+The sidecar ``example_servo.truth.json`` (format ``gyrocal.simulation-truth``, the same as
+``gyrocal simulate`` writes) holds the true parameters, the mounting rotation and the true windows. The run is seeded, so the output is reproducible.
 """
 
 from __future__ import annotations
@@ -30,12 +30,13 @@ import numpy as np
 from gyrocal import ScaleBias
 from gyrocal.simulation import VirtualGyro
 from gyrocal.simulation.servo import ServoProtocol, simulate_servo
+from gyrocal.simulation.truth import SimulationTruth, servo_facts
 
 SEED = 20260522
 SAMPLE_RATE = 200.0  # Hz
-K = (1.0069, 0.9960, 0.9955)  # seed 000, Table III, MPU9250
+K = (1.0069, 0.9960, 0.9955)  # the servo method of Wang et al., Table III, MPU9250
 B = (0.0442, -0.0089, 0.0076)  # rad/s, same table
-NOISE_STD = 0.035  # rad/s per sample, seed 000's simulation setting
+NOISE_STD = 0.035  # rad/s per sample, that paper's simulation setting
 LSB_PER_DPS = 131.0  # MPU9250 at +-250 deg/s
 FULL_SCALE_DPS = 250.0
 DATA = Path(__file__).resolve().parents[1] / "src" / "gyrocal" / "data"
@@ -61,25 +62,20 @@ def csv_text(rec) -> str:
 
 
 def truth_doc(truth, protocol: ServoProtocol) -> dict:
-    return {
-        "format": "gyrocal.example-truth",
-        "version": 1,
-        "description": "Simulated MPU9250 (seed 000 Table III) on seed 000's servo protocol; "
-                       "regenerate with tools/make_example.py",
-        "seed": SEED,
-        "sample_rate": SAMPLE_RATE,
-        "units": {"csv": "deg/s", "k": "1", "b": "rad/s", "noise_std": "rad/s"},
-        "k": list(K),
-        "b": list(B),
-        "noise_std": NOISE_STD,
-        "quantum_deg_s": 1.0 / LSB_PER_DPS,
-        "protocol": {"speed_deg_s": 60.0, "turns": list(protocol.turns), "wait_s": protocol.wait,
-                     "ramp_s": protocol.ramp, "vibration": protocol.vibration,
-                     "misalignment_deg": protocol.misalignment_deg},
-        "mounting": np.asarray(truth.mounting).tolist(),
-        "windows": [w.to_dict() for w in truth.windows],
-        "plateaus": [w.to_dict() for w in truth.plateaus],
+    """The truth sidecar, in the one format of simulated truth (gyrocal.simulation.truth)."""
+    settings = {
+        "seed": SEED, "sample_rate": SAMPLE_RATE, "units": "deg/s", "noise_std": NOISE_STD,
+        "quantum_deg_s": 1.0 / LSB_PER_DPS, "full_scale_deg_s": FULL_SCALE_DPS, "speed_deg_s": 60.0,
+        "turns": list(protocol.turns), "wait_s": protocol.wait, "ramp_s": protocol.ramp,
+        "vibration": protocol.vibration, "misalignment_deg": protocol.misalignment_deg,
     }
+    doc = SimulationTruth(
+        protocol="servo", model=truth.model, settings=settings, facts=servo_facts(truth),
+        description="Simulated MPU9250 (the servo method of Wang et al., Table III) on its servo protocol; "
+                    "regenerate with tools/make_example.py",
+    ).to_document()
+    doc["created_by"] = "tools/make_example.py"  # not the version: --check must not fail on a release
+    return doc
 
 
 def generate() -> tuple[str, str]:

@@ -1,34 +1,50 @@
 """gyrocal: calibrate triaxial MEMS gyroscopes.
 
 The core depends on numpy and scipy only; the command line, plots and bag readers
-are extras imported where they are used.
+are extras imported where they are used. The names below are loaded on first use,
+so ``import gyrocal`` (and ``gyrocal --help``) does not pay for numpy.
 """
 
-__version__ = "0.1.0"
+from __future__ import annotations
 
-from .calibration import Calibration, load_calibration, save_calibration  # noqa: E402
-from .errors import GyrocalError  # noqa: E402
-from .estimators import Algorithm1, BatchFit, FirstMoment, FitResult, PaperLM, make_estimator  # noqa: E402
-from .models import Affine, ScaleBias  # noqa: E402
-from .observations import Observation, ObservationSet, observe  # noqa: E402
-from .recording import Recording  # noqa: E402
+import importlib
 
-__all__ = [
-    "__version__",
-    "GyrocalError",
-    "ScaleBias",
-    "Affine",
-    "Observation",
-    "ObservationSet",
-    "observe",
-    "Algorithm1",
-    "PaperLM",
-    "FirstMoment",
-    "FitResult",
-    "BatchFit",
-    "make_estimator",
-    "Recording",
-    "Calibration",
-    "save_calibration",
-    "load_calibration",
-]
+from ._version import __version__
+
+#: Public name -> module that defines it.
+_EXPORTS = {
+    "GyrocalError": "errors",
+    "ScaleBias": "models",
+    "Affine": "models",
+    "Observation": "observations",
+    "ObservationSet": "observations",
+    "observe": "observations",
+    "Algorithm1": "estimators",
+    "PaperLM": "estimators",
+    "FirstMoment": "estimators",
+    "FitResult": "estimators",
+    "BatchFit": "estimators",
+    "make_estimator": "estimators",
+    "Recording": "recording",
+    "Calibration": "calibration",
+    "ThermalCalibration": "thermal",
+    "load": "files",
+    "save": "files",
+    "save_calibration": "files",
+    "load_calibration": "files",
+    "read_recording": "io",
+}
+
+__all__ = ["__version__", *_EXPORTS]
+
+
+def __getattr__(name: str):
+    if name not in _EXPORTS:
+        raise AttributeError(f"module 'gyrocal' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{_EXPORTS[name]}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_EXPORTS))

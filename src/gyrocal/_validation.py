@@ -41,9 +41,29 @@ def positive(name: str, value: float) -> float:
     try:
         v = float(value)
     except (TypeError, ValueError) as exc:
-        raise InputError(f"{name} must be a number, got {value!r}") from exc
+        raise InputError(f"{{param}} must be a number, got {value!r}", param=name, value=value) from exc
     if not np.isfinite(v):
-        raise NonFiniteInputError(f"{name} must be finite and > 0, got {value!r}")
+        raise NonFiniteInputError(f"{{param}} must be finite and > 0, got {value!r}", param=name, value=value)
     if v <= 0:
-        raise InputError(f"{name} must be finite and > 0, got {value!r}")
+        raise InputError(f"{{param}} must be finite and > 0, got {value!r}", param=name, value=value)
     return v
+
+
+def at_least(name: str, value: float, low: float, unit: str = "") -> float:
+    """Return `value` as a float, refusing anything that is not finite and >= `low`."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{{param}} must be a number, got {value!r}", param=name, value=value) from exc
+    if not (np.isfinite(v) and v >= low):
+        raise InputError(f"{{param}} must be finite and >= {low:g}{unit}, got {value!r}", param=name, value=value)
+    return v
+
+
+def refuse_options(options: dict, accepted: tuple[str, ...], what: str) -> None:
+    """Refuse keyword options that `what` does not take, naming the first one (``param``)."""
+    unknown = [k for k in options if k not in accepted]
+    if unknown:
+        took = f"it takes {', '.join(accepted)}" if accepted else "it takes none"
+        raise InputError(f"{{param}} does not apply to {what} ({took})", param=unknown[0],
+                         value=options[unknown[0]])

@@ -8,11 +8,11 @@ static waits. For a true model, a per-sample noise level and a sample rate it gi
   (:func:`gyrocal.estimators.first_moment.residuals_and_jacobian`) evaluated on the
   noise-free expected windows, so the plan and the fit's covariance are one piece
   of code;
-* D- and G-efficiency of the rotation axes for seed 000's regression model (section
+* D- and G-efficiency of the rotation axes for the servo method's regression model (section
   II-B), defined below;
 * the total protocol time.
 
-Efficiencies (seed 000, section II-B). The paper's regression (eq. 4, 7) has the
+Efficiencies (the servo method of Wang et al., section II-B). The paper's regression (eq. 4, 7) has the
 six regressors ``f(x) = [x1^2, x2^2, x3^2, x1, x2, x3]`` of a reading direction
 ``x`` on the unit sphere (the design region: ``|m| ~ omega``, scaled to 1). For a
 design with rotation directions ``x_i`` and weights ``w_i`` (sample counts,
@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ._arrays import readonly
 from ._validation import finite_array, positive
 from .errors import InputError
 from .estimators._checks import require_count, require_full_rank
@@ -91,9 +92,7 @@ class Rotation:
         norm = float(np.linalg.norm(a))
         if norm == 0:
             raise InputError("axis must be a non-zero vector, got [0, 0, 0]")
-        a = a / norm
-        a.setflags(write=False)
-        object.__setattr__(self, "axis", a)
+        object.__setattr__(self, "axis", readonly(a / norm, copy=False))
         object.__setattr__(self, "speed", positive("speed", self.speed))
         object.__setattr__(self, "angle", positive("angle", self.angle))
 
@@ -160,7 +159,7 @@ class Design:
 
     @classmethod
     def paper_six(cls, speed: float = math.pi / 3, pause: float = 3.0) -> Design:
-        """Seed 000 Fig. 1: one revolution about +x, -x, +y, -y, +z, -z, 3 s apart. G-optimal."""
+        """The servo method of Wang et al., Fig. 1: one revolution about +x, -x, +y, -y, +z, -z, 3 s apart. G-optimal."""
         return cls.from_axes(("+x", "-x", "+y", "-y", "+z", "-z"), speed, pause=pause, name="paper six")
 
     @classmethod
@@ -217,7 +216,7 @@ def expected_observations(design: Design, model=None, sample_rate: float = 200.0
     fs = positive("sample_rate", sample_rate)
     rot = [isinstance(w, Rotation) for w in design.windows]
     true = np.array([w.speed * w.axis if r else np.zeros(3) for w, r in zip(design.windows, rot)])
-    mean = model.distort(true)  # seed 000 eq. 1 solved for m
+    mean = model.distort(true)  # the servo method of Wang et al., eq. 1 solved for m
     count = np.array([max(2, round(w.duration * fs)) for w in design.windows], dtype=float)
     nv = np.broadcast_to(np.square(np.asarray(noise_std, dtype=float)), mean.shape)
     rate = np.array([w.speed if r else 0.0 for w, r in zip(design.windows, rot)])
@@ -290,7 +289,7 @@ def predicted_covariance(design: Design, model=None, noise_std=None, sample_rate
 
 
 def _regressors(x: np.ndarray) -> np.ndarray:
-    """Seed 000 eq. 7 regressors ``[x^2, x]`` of directions x (n, 3)."""
+    """The servo method of Wang et al., eq. 7 regressors ``[x^2, x]`` of directions x (n, 3)."""
     return np.concatenate([x * x, x], axis=-1)
 
 
@@ -304,7 +303,7 @@ def _moment_matrix(design: Design) -> np.ndarray:
 
 
 def d_efficiency(design: Design) -> float:
-    """``(det M / det M*)^(1/6)`` for seed 000's regression on the sphere; 1 for the paper's six."""
+    """``(det M / det M*)^(1/6)`` for the servo method's regression on the sphere; 1 for the paper's six."""
     det = np.linalg.det(_moment_matrix(design))
     return float(max(det, 0.0) / _REFERENCE_DET) ** (1.0 / _P)
 

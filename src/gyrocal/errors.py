@@ -1,10 +1,19 @@
-"""Exceptions raised by gyrocal.
+"""Exceptions and warnings raised by gyrocal.
 
 Every error the package raises on purpose derives from :class:`GyrocalError`, so a
 caller (and the command line) can tell a problem with the input from a bug.
+
+Errors carry data, not prose for one front end: ``param`` names the Python parameter
+at fault, ``value`` the value received and ``hint`` how to fix it. A message or hint
+may say ``{param}`` where the parameter's name belongs; :meth:`GyrocalError.render`
+fills it in with the caller's name for it (the Python name by default, a flag such
+as ``--out-of-range`` on the command line), so no front end rewrites the text.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
 
 __all__ = [
     "GyrocalError",
@@ -22,9 +31,40 @@ __all__ = [
     "GyrocalWarning",
 ]
 
+PARAM = "{param}"
+
 
 class GyrocalError(Exception):
-    """Base class of every error raised by gyrocal on purpose."""
+    """Base class of every error raised by gyrocal on purpose.
+
+    Parameters
+    ----------
+    message : str
+        What is wrong, in one sentence; may say ``{param}`` for the parameter's name.
+    param : str, optional
+        The Python parameter at fault (``"sample_rate"``); front ends map it to their own name.
+    value : object, optional
+        The value received.
+    hint : str, optional
+        How to fix it; may say ``{param}`` too.
+    """
+
+    def __init__(self, message: str, *, param: str | None = None, value: Any = None, hint: str | None = None):
+        super().__init__(message)
+        self.message = message
+        self.param = param
+        self.value = value
+        self.hint = hint
+
+    def render(self, name: Callable[[str], str] | None = None) -> str:
+        """The one-line text, with ``{param}`` replaced by ``name(param)`` (default: the Python name)."""
+        text = self.message if not self.hint else f"{self.message}; {self.hint}"
+        if self.param is not None:
+            text = text.replace(PARAM, name(self.param) if name is not None else self.param)
+        return text
+
+    def __str__(self) -> str:
+        return self.render()
 
 
 class InputError(GyrocalError, ValueError):
@@ -60,8 +100,8 @@ class ConvergenceError(GyrocalError):
         Iterations performed before giving up.
     """
 
-    def __init__(self, message: str, iterations: int):
-        super().__init__(message)
+    def __init__(self, message: str, iterations: int, **fields):
+        super().__init__(message, **fields)
         self.iterations = iterations
 
 
@@ -74,8 +114,8 @@ class FileFormatError(GyrocalError):
         The offending field, dotted (``"correction.matrix"``), when one is to blame.
     """
 
-    def __init__(self, message: str, field: str | None = None):
-        super().__init__(message)
+    def __init__(self, message: str, field: str | None = None, **fields):
+        super().__init__(message, **fields)
         self.field = field
 
 

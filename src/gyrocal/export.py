@@ -1,92 +1,100 @@
-"""Export a calibration or thermal calibration file as JSON, YAML or a C header.
+"""Export registry: write a calibration file in another format (JSON, YAML, a C header, ...).
 
-Both kinds of file are versioned JSON that name themselves in their ``format``
-field; :func:`load_any` dispatches on it, so every command that takes "a
-calibration file" accepts either kind.
+An exporter is a function ``fn(obj, **options) -> str`` for some file kinds, registered
+under a format name with :func:`register_exporter` by the module that defines it.
+:data:`EXPORTER_MODULES` names the module of each format, so this module stays light
+(``EXPORT_FORMATS`` needs no import of numpy) and an exporter is imported when it is used.
 """
 
 from __future__ import annotations
 
-import json
+import importlib
 import os
-from typing import Literal, get_args
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
 
 from ._atomic import write_text_atomic
-from ._jsonfile import read_json
-from .calibration import FORMAT as CALIBRATION_FORMAT
-from .calibration import Calibration, from_document
-from .errors import FileFormatError, InputError, MissingDependencyError
+from .errors import InputError
 
-__all__ = ["EXPORT_FORMATS", "THERMAL_FORMAT", "ExportFormat", "export_file", "load_any", "render"]
+__all__ = ["EXPORTER_MODULES", "EXPORT_FORMATS", "Exporter", "export_file", "exporter", "register_exporter", "render"]
 
-ExportFormat = Literal["json", "yaml", "c-header"]
-EXPORT_FORMATS: tuple[str, ...] = get_args(ExportFormat)
-THERMAL_FORMAT = "gyrocal.thermal"
-
-
-def _load_doc(doc: dict, path):
-    kind = doc.get("format")
-    if kind == CALIBRATION_FORMAT:
-        return from_document(doc, path)
-    if kind == THERMAL_FORMAT:
-        from .thermal import load_thermal
-
-        return load_thermal(path)
-    raise FileFormatError(
-        f"{path}: field 'format' is {kind!r}; expected {CALIBRATION_FORMAT!r} or {THERMAL_FORMAT!r}", "format"
-    )
+#: Format name -> module that registers its exporter (add a line for a new format).
+EXPORTER_MODULES: dict[str, str] = {
+    "json": "gyrocal.exporters",
+    "yaml": "gyrocal.exporters",
+    "c-header": "gyrocal.exporters",
+}
+#: The export formats, in the order the command line lists them.
+EXPORT_FORMATS: tuple[str, ...] = tuple(EXPORTER_MODULES)
 
 
-def load_any(path: str | os.PathLike):
-    """Read and validate a calibration file of either kind.
+@dataclass(frozen=True)
+class Exporter:
+    """A registered exporter.
 
-    Returns
-    -------
-    Calibration or gyrocal.thermal.ThermalCalibration
-        Chosen by the file's ``format`` field (``gyrocal.calibration`` or ``gyrocal.thermal``).
+    Attributes
+    ----------
+    name : str
+        Format name (``"c-header"``).
+    kinds : tuple of type, or None
+        File kinds it exports; None for every registered kind.
+    fn : callable
+        ``fn(obj, **options) -> str``.
+    suffix : str
+        Usual file suffix of its output (``".h"``).
     """
-    return _load_doc(read_json(path), path)
+
+    name: str
+    kinds: tuple[type, ...] | None
+    fn: Callable[..., str]
+    suffix: str
 
 
-def _c_header(obj) -> str:
-    try:
-        from . import firmware
-    except ImportError:
-        raise MissingDependencyError("this gyrocal build has no C-header exporter (gyrocal.firmware)") from None
-    return firmware.c_header(obj) if isinstance(obj, Calibration) else firmware.thermal_c_header(obj)
+_REGISTRY: dict[str, Exporter] = {}
 
 
-def _yaml(doc: dict) -> str:
-    try:
-        import yaml
-    except ImportError:
-        raise MissingDependencyError("YAML export needs pyyaml: pip install 'gyrocal[yaml]'") from None
-    return yaml.safe_dump(doc, sort_keys=False, default_flow_style=None, width=120)
+def register_exporter(name: str, kinds: tuple[type, ...] | None, fn: Callable[..., str], *, suffix: str) -> None:
+    """Register `fn` as the exporter of format `name` for objects of `kinds` (None: every file kind)."""
+    if name not in EXPORTER_MODULES:
+        raise InputError(f"export format {name!r} is not listed in gyrocal.export.EXPORTER_MODULES; add it there")
+    _REGISTRY[name] = Exporter(name, None if kinds is None else tuple(kinds), fn, suffix)
 
 
-def render(path: str | os.PathLike, fmt: ExportFormat) -> str:
-    """The text of calibration file `path` in export format `fmt`.
+def exporter(fmt: str) -> Exporter:
+    """The exporter of format `fmt`, importing its module when needed."""
+    if fmt not in EXPORTER_MODULES:
+        raise InputError(f"{{param}}={fmt!r} is not one of {', '.join(EXPORT_FORMATS)}", param="fmt", value=fmt)
+    if fmt not in _REGISTRY:
+        importlib.import_module(EXPORTER_MODULES[fmt])
+    return _REGISTRY[fmt]
 
-    The file is validated first. ``json`` and ``yaml`` carry the same document;
-    ``c-header`` is firmware code from :mod:`gyrocal.firmware`.
+
+def render(obj_or_path: Any, fmt: str, **options) -> str:
+    """The text of a calibration (an object, or a file read with :func:`gyrocal.files.load`) in format `fmt`.
 
     Parameters
     ----------
-    path : path-like
-        A ``gyrocal.calibration`` or ``gyrocal.thermal`` file.
-    fmt : {"json", "yaml", "c-header"}
+    obj_or_path : file kind or path-like
+        A calibration object, or the path of any gyrocal file.
+    fmt : str
+        One of :data:`EXPORT_FORMATS`.
+    **options
+        Passed to the exporter (``prefix`` for ``c-header``).
     """
-    if fmt not in EXPORT_FORMATS:
-        raise InputError(f"format={fmt!r} is not one of {', '.join(EXPORT_FORMATS)}")
-    doc = read_json(path)
-    obj = _load_doc(doc, path)
-    if fmt == "json":
-        return json.dumps(doc, indent=2, allow_nan=False) + "\n"
-    if fmt == "yaml":
-        return _yaml(doc)
-    return _c_header(obj)
+    ex = exporter(fmt)
+    obj = obj_or_path
+    if isinstance(obj_or_path, (str, os.PathLike)):
+        from .files import load
+
+        obj = load(obj_or_path)
+    if ex.kinds is not None and not isinstance(obj, ex.kinds):
+        names = ", ".join(getattr(k, "FORMAT", k.__name__) for k in ex.kinds)
+        raise InputError(f"{fmt} export takes {names}, not {getattr(obj, 'FORMAT', type(obj).__name__)}",
+                         param="fmt", value=fmt)
+    return ex.fn(obj, **options)
 
 
-def export_file(path: str | os.PathLike, fmt: ExportFormat, out: str | os.PathLike) -> None:
-    """Write :func:`render` of `path` to `out`, atomically."""
-    write_text_atomic(out, render(path, fmt))
+def export_file(path: str | os.PathLike, fmt: str, out: str | os.PathLike, **options) -> None:
+    """Write :func:`render` of file `path` to `out`, atomically."""
+    write_text_atomic(out, render(path, fmt, **options))

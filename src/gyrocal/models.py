@@ -7,8 +7,8 @@ stores each in the canonical form
 
 and keeps each paper's own parameters, converting exactly in both directions:
 
-* :class:`ScaleBias` (seed 000, eq. 1): ``g = diag(k) (m + b)``, so ``A = diag(k)``, ``o = -b``.
-* :class:`Affine` (seed 001, eq. 12): ``w = K w~ + B``, so ``A = K^-1``, ``o = B``.
+* :class:`ScaleBias` (the servo method of Wang et al., eq. 1): ``g = diag(k) (m + b)``, so ``A = diag(k)``, ``o = -b``.
+* :class:`Affine` (the full-temperature-range method, eq. 12): ``w = K w~ + B``, so ``A = K^-1``, ``o = B``.
 
 Models are unit-agnostic numbers: ``o`` is in the units of the readings and ``A``
 maps reading units to output units. The package keeps both in rad/s inside; files
@@ -22,12 +22,13 @@ from typing import ClassVar
 
 import numpy as np
 
+from ._arrays import readonly
 from ._validation import finite_array, vector3
 from .errors import InputError, NonPhysicalEstimateError
 
-__all__ = ["KG_INDEX", "KG_NAMES", "Affine", "CalibrationModel", "ScaleBias", "correct"]
+__all__ = ["KG_INDEX", "KG_NAMES", "Affine", "CalibrationModel", "ScaleBias", "correct", "kb_to_kg", "kg_to_kb"]
 
-#: Seed 001 eq. 14: element order of the 12-vector Kg.
+#: The full-temperature-range method, eq. 14: element order of the 12-vector Kg.
 KG_NAMES: tuple[str, ...] = ("Kxx", "Kyy", "Kzz", "Kyx", "Kzx", "Kxy", "Kzy", "Kxz", "Kyz", "Bx", "By", "Bz")
 #: Position in K (eq. 11) of each of the first nine Kg elements.
 #: K = [[Kxx, Kyx, Kzx], [Kxy, Kyy, Kzy], [Kxz, Kyz, Kzz]], so row = output axis, column = input axis.
@@ -36,21 +37,32 @@ _KG_ROWS = np.array([r for r, _ in KG_INDEX])
 _KG_COLS = np.array([c for _, c in KG_INDEX])
 
 
+def kg_to_kb(kg) -> tuple[np.ndarray, np.ndarray]:
+    """``K`` (..., 3, 3) and ``B`` (..., 3) from Kg vectors (..., 12): the one Kg -> K mapping (eq. 11, 14).
+
+    The C library's ``gyrocal_thermal_correct`` unpacks Kg the same way; a test ties the two.
+    """
+    kg = np.asarray(kg, dtype=float)
+    K = np.zeros(kg.shape[:-1] + (3, 3))
+    K[..., _KG_ROWS, _KG_COLS] = kg[..., :9]
+    return K, kg[..., 9:].copy()
+
+
+def kb_to_kg(K, B) -> np.ndarray:
+    """Kg vectors (..., 12) from ``K`` (..., 3, 3) and ``B`` (..., 3): the inverse of :func:`kg_to_kb`."""
+    K = np.asarray(K, dtype=float)
+    return np.concatenate([K[..., _KG_ROWS, _KG_COLS], np.asarray(B, dtype=float)], axis=-1)
+
+
 def correct(matrix: np.ndarray, offset: np.ndarray, readings) -> np.ndarray:
     """Apply ``w_true = matrix @ (m - offset)`` to readings of shape (..., 3) [reading units]."""
     m = finite_array("readings", readings, shape_tail=(3,))
     return (m - offset) @ np.asarray(matrix).T
 
 
-def _freeze(arr: np.ndarray) -> np.ndarray:
-    arr = np.array(arr, dtype=float)
-    arr.setflags(write=False)
-    return arr
-
-
 @dataclass(frozen=True)
 class ScaleBias:
-    """Per-axis scale and bias, seed 000 eq. 1: ``g = diag(k) (m + b)``.
+    """Per-axis scale and bias, the servo method of Wang et al., eq. 1: ``g = diag(k) (m + b)``.
 
     Parameters
     ----------
@@ -70,8 +82,8 @@ class ScaleBias:
         k = vector3("k", self.k)
         if np.any(k <= 0):
             raise NonPhysicalEstimateError(f"scale factors k must be > 0, got {k.tolist()}")
-        object.__setattr__(self, "k", _freeze(k))
-        object.__setattr__(self, "b", _freeze(vector3("b", self.b)))
+        object.__setattr__(self, "k", readonly(k, copy=True))
+        object.__setattr__(self, "b", readonly(vector3("b", self.b), copy=True))
 
     @property
     def matrix(self) -> np.ndarray:
@@ -115,13 +127,13 @@ class ScaleBias:
         return Affine.from_canonical(self.matrix, self.offset)
 
     def to_dict(self) -> dict:
-        """Seed 000 parameters, as plain lists."""
+        """The servo method's parameters (Wang et al., eq. 1), as plain lists."""
         return {"k": self.k.tolist(), "b": self.b.tolist()}
 
 
 @dataclass(frozen=True)
 class Affine:
-    """Full 12-parameter model, seed 001 eq. 12: ``w = K w~ + B``.
+    """Full 12-parameter model, the full-temperature-range method, eq. 12: ``w = K w~ + B``.
 
     Parameters
     ----------
@@ -142,8 +154,8 @@ class Affine:
         cond = np.linalg.cond(K)
         if not np.isfinite(cond) or cond > 1e12:
             raise NonPhysicalEstimateError(f"K is singular (condition number {cond:.3g}); it cannot be inverted")
-        object.__setattr__(self, "K", _freeze(K))
-        object.__setattr__(self, "B", _freeze(vector3("B", self.B)))
+        object.__setattr__(self, "K", readonly(K, copy=True))
+        object.__setattr__(self, "B", readonly(vector3("B", self.B), copy=True))
 
     @property
     def matrix(self) -> np.ndarray:
@@ -157,8 +169,8 @@ class Affine:
 
     @property
     def kg(self) -> np.ndarray:
-        """Seed 001 eq. 14 12-vector ``[Kxx, Kyy, Kzz, Kyx, Kzx, Kxy, Kzy, Kxz, Kyz, Bx, By, Bz]``."""
-        return np.concatenate([self.K[_KG_ROWS, _KG_COLS], self.B])
+        """The full-temperature-range method, eq. 14 12-vector ``[Kxx, Kyy, Kzz, Kyx, Kzx, Kxy, Kzy, Kxz, Kyz, Bx, By, Bz]``."""
+        return kb_to_kg(self.K, self.B)
 
     @property
     def params(self) -> np.ndarray:
@@ -167,11 +179,8 @@ class Affine:
 
     @classmethod
     def from_kg(cls, kg) -> Affine:
-        """Build from the seed 001 12-vector (eq. 14 order)."""
-        v = finite_array("kg", kg, shape_tail=(12,), ndim=1)
-        K = np.zeros((3, 3))
-        K[_KG_ROWS, _KG_COLS] = v[:9]
-        return cls(K=K, B=v[9:])
+        """Build from the full-temperature-range method 12-vector (eq. 14 order)."""
+        return cls(*kg_to_kb(finite_array("kg", kg, shape_tail=(12,), ndim=1)))
 
     from_params = from_kg
 
@@ -196,8 +205,8 @@ class Affine:
         return self
 
     def to_dict(self) -> dict:
-        """Seed 001 parameters: Kg in eq. 14 order, with names."""
-        return {"kg": self.kg.tolist(), "kg_names": list(KG_NAMES)}
+        """The full-temperature-range method's parameters: K, B, and Kg in eq. 14 order with that order."""
+        return {"K": self.K.tolist(), "B": self.B.tolist(), "kg": self.kg.tolist(), "kg_order": list(KG_NAMES)}
 
 
 CalibrationModel = ScaleBias | Affine

@@ -25,6 +25,7 @@ import numpy as np
 
 from ._jsonfile import check_header, get, get_array, read_json, write_json
 from ._validation import finite_array, positive
+from ._arrays import readonly
 from .errors import FileFormatError, InputError, MissingDependencyError
 
 __all__ = ["NoiseReport", "allan_deviation", "characterise", "save_noise", "load_noise", "noise_density_arg"]
@@ -72,10 +73,9 @@ class NoiseReport:
         m = np.shape(self.taus)[0]
         for name, shape in (("taus", (m,)), ("adev", (3, m)), ("arw", (3,)), ("bias_instability", (3,)),
                             ("bias_instability_tau", (3,)), ("rrw", (3,))):
-            arr = np.array(getattr(self, name), dtype=float)
+            arr = readonly(getattr(self, name), copy=True)
             if arr.shape != shape:
                 raise InputError(f"{name} must have shape {shape}, got {arr.shape}")
-            arr.setflags(write=False)
             object.__setattr__(self, name, arr)
 
     @property

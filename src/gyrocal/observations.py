@@ -20,6 +20,7 @@ from typing import Literal
 
 import numpy as np
 
+from ._arrays import readonly
 from ._validation import finite_array, positive
 from .errors import InputError
 
@@ -38,7 +39,7 @@ class Observation:
     mean : ndarray, shape (3,)
         Window mean of the readings [reading units].
     mean_sq : ndarray, shape (3,)
-        Window mean of the squared readings [reading units^2] (seed 000 eq. 8 regressors).
+        Window mean of the squared readings [reading units^2] (the servo method of Wang et al., eq. 8 regressors).
     noise_var : ndarray, shape (3,)
         Per-sample white-noise variance, from first differences [reading units^2].
         Differencing removes the rotation itself, ramps and slow vibration.
@@ -66,8 +67,7 @@ class Observation:
     def __post_init__(self):
         for name in ("mean", "mean_sq", "noise_var"):
             arr = finite_array(name, getattr(self, name), shape_tail=(3,), ndim=1)
-            arr.setflags(write=False)
-            object.__setattr__(self, name, arr)
+            object.__setattr__(self, name, readonly(arr, copy=True))
         if self.kind not in _KINDS:
             raise InputError(f"kind={self.kind!r} is not one of {_KINDS}")
         if int(self.count) < 2:

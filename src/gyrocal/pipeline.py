@@ -8,7 +8,7 @@ Method S, first-moment form). A windows file overrides detection.
 Which windows each method uses:
 
 * ``first-moment``: rotations and static windows (static windows give ``m = -b``).
-* ``algorithm1`` and ``lm`` (seed 000's mean-of-squares regression, eq. 4-8): rotations
+* ``algorithm1`` and ``lm`` (the servo method's mean-of-squares regression, eq. 4-8): rotations
   only. A static row would read ``y = 0`` against ``k^2 mean(m^2)``, which holds the noise
   power ``k^2 sigma^2``, so static rows would add bias, not information.
 """
@@ -84,7 +84,7 @@ class CalibrationRun:
         # noise power in each window's mean of squares: |k (m + b)|^2 grows by sum_j k_j^2 s_j^2
         low = float(np.mean(np.sum(fit.model.k**2 * fit.noise_std**2) / (2 * rates**2)))
         return (f"{self.calibration.method} reads k low by about {low:.2g} (the noise power in its mean of squares); "
-                "its 1-sigma is the spread only; method first-moment is unbiased")
+                "its 1-sigma is the spread only; the first-moment method is unbiased")
 
     def report(self) -> str:
         """Plain-text summary: parameters in user units with 1-sigma, and the correction."""

@@ -9,18 +9,18 @@ deviations of the scale factors and biases.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal, Sequence, get_args
+from typing import Sequence, get_args
 
 import numpy as np
 
 from ._validation import positive
+from .choices import DesignName
 from .design import Design, predicted_std
 from .errors import InputError
 from .models import ScaleBias
 
 __all__ = ["DesignName", "DESIGN_NAMES", "Plan", "build_design", "predict", "suggest"]
 
-DesignName = Literal["six", "six-static", "twelve"]
 DESIGN_NAMES: tuple[str, ...] = get_args(DesignName)
 
 
@@ -67,7 +67,7 @@ def build_design(name: DesignName, speed: float, *, revolutions: float = 1.0, st
                  pause: float = 3.0) -> Design:
     """A named design at `speed` [rad/s] with `revolutions` per turn.
 
-    ``six``: seed 000 Fig. 1, +-x, +-y, +-z, `pause` [s] between turns (not used).
+    ``six``: the servo method of Wang et al., Fig. 1, +-x, +-y, +-z, `pause` [s] between turns (not used).
     ``six-static``: the same with each wait recorded as a static window of `static_duration` [s].
     ``twelve``: one turn about each of the 12 face diagonals of the cube.
     """

@@ -7,17 +7,12 @@ from typing import Literal
 
 import numpy as np
 
+from ._arrays import readonly
+from .choices import AccelUnit, values
 from ._validation import finite_array, positive
 from .errors import InputError
 
 __all__ = ["Recording"]
-
-
-def _readonly(arr: np.ndarray) -> np.ndarray:
-    # A read-only view, not a copy: copying 10-million-sample logs costs more than parsing them.
-    view = np.asarray(arr).view()
-    view.setflags(write=False)
-    return view
 
 
 @dataclass(frozen=True)
@@ -51,6 +46,14 @@ class Recording:
         Other columns, passed through unchanged by ``apply``.
     sensitivity : float or None
         LSB per output rate unit, when raw counts were converted to rad/s.
+    accel : ndarray, shape (N, 3), or None
+        Accelerometer readings [m/s^2], or raw counts when ``accel_units == "counts"``.
+    accel_units : {"m/s^2", "counts"} or None
+        Internal unit of ``accel`` (counts only when no sensitivity was known).
+    accel_source_units : {"m/s^2", "g", "counts"} or None
+        Unit the accelerometer data were declared in, for output.
+    accel_sensitivity : float or None
+        LSB per g, when raw accelerometer counts were converted to m/s^2.
     """
 
     t: np.ndarray
@@ -64,6 +67,10 @@ class Recording:
     axis: np.ndarray | None = None
     extra: dict[str, np.ndarray] = field(default_factory=dict)
     sensitivity: float | None = None
+    accel: np.ndarray | None = None
+    accel_units: Literal["m/s^2", "counts"] | None = None
+    accel_source_units: str | None = None
+    accel_sensitivity: float | None = None
 
     def __post_init__(self):
         gyro = finite_array("gyro", self.gyro, shape_tail=(3,), ndim=2)
@@ -79,20 +86,43 @@ class Recording:
             raise InputError(f"units must be 'rad/s' or 'counts' inside gyrocal, got {self.units!r}")
         fs = self.sample_rate or (1.0 / float(np.median(np.diff(t))) if n >= 2 else 0.0)
         object.__setattr__(self, "sample_rate", positive("sample_rate", fs))
-        object.__setattr__(self, "t", _readonly(t))
-        object.__setattr__(self, "gyro", _readonly(gyro))
+        object.__setattr__(self, "t", readonly(t, None, copy=False))
+        object.__setattr__(self, "gyro", readonly(gyro, None, copy=False))
         for name in ("temp", "table_rate"):
             value = getattr(self, name)
             if value is not None:
                 arr = finite_array(name, value, ndim=1)
                 if arr.shape != (n,):
                     raise InputError(f"{name} has {len(arr)} samples but gyro has {n}")
-                object.__setattr__(self, name, _readonly(arr))
+                object.__setattr__(self, name, readonly(arr, None, copy=False))
         if self.axis is not None:
             axis = np.char.lower(np.asarray(self.axis, dtype=str))
             if axis.shape != (n,) or not np.isin(axis, ("x", "y", "z")).all():
                 raise InputError("axis must hold one of 'x', 'y', 'z' for every sample")
-            object.__setattr__(self, "axis", _readonly(axis))
+            object.__setattr__(self, "axis", readonly(axis, None, copy=False))
+        self._check_accel(n)
+
+    def _check_accel(self, n: int) -> None:
+        if self.accel is None:
+            if self.accel_units is not None or self.accel_source_units is not None or self.accel_sensitivity is not None:
+                raise InputError("accel_units, accel_source_units and accel_sensitivity need accel data")
+            return
+        accel = finite_array("accel", self.accel, shape_tail=(3,), ndim=2)
+        if len(accel) != n:
+            raise InputError(f"accel has {len(accel)} samples but gyro has {n}")
+        units = self.accel_units or "m/s^2"
+        if units not in ("m/s^2", "counts"):
+            raise InputError(f"accel_units must be 'm/s^2' or 'counts' inside gyrocal, got {units!r}",
+                             param="accel_units", value=units)
+        source = self.accel_source_units or units
+        if source not in values(AccelUnit):
+            raise InputError(f"accel_source_units must be one of {', '.join(values(AccelUnit))}, got {source!r}",
+                             param="accel_source_units", value=source)
+        if self.accel_sensitivity is not None:
+            positive("accel_sensitivity", self.accel_sensitivity)
+        object.__setattr__(self, "accel", readonly(accel, None, copy=False))
+        object.__setattr__(self, "accel_units", units)
+        object.__setattr__(self, "accel_source_units", source)
 
     def __len__(self) -> int:
         return len(self.gyro)

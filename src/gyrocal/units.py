@@ -7,17 +7,15 @@ reading, printing or exporting, and every saved file records the units it uses.
 from __future__ import annotations
 
 import math
-from typing import Literal, get_args
+from typing import get_args
 
 import numpy as np
 
+from .choices import InputUnit, RateUnit
 from .errors import UnitError
 
 __all__ = ["RateUnit", "InputUnit", "RATE_UNITS", "parse_rate_unit", "parse_input_unit", "to_rad_s", "from_rad_s", "unit_factor"]
 
-RateUnit = Literal["rad/s", "deg/s"]
-#: Units a recording may be in; ``counts`` are raw integers, optionally with a sensitivity.
-InputUnit = Literal["rad/s", "deg/s", "counts"]
 
 RATE_UNITS: tuple[str, ...] = get_args(RateUnit)
 _FACTOR_TO_RAD_S = {"rad/s": 1.0, "deg/s": math.pi / 180.0}

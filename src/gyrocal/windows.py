@@ -62,3 +62,11 @@ class Window:
         d["rate"] = None if math.isnan(self.rate) else self.rate
         del d["angle"]
         return d
+
+    @classmethod
+    def from_dict(cls, d: dict) -> Window:
+        """The window of a record written by :meth:`to_dict` (as kept in a calibration file)."""
+        angle, rate = d.get("angle_deg"), d.get("rate")
+        return cls(int(d["start"]), int(d["stop"]), d["kind"], d.get("axis"), int(d.get("sign") or 0),
+                   math.nan if angle is None else math.radians(angle), math.nan if rate is None else float(rate),
+                   str(d.get("label") or ""))

@@ -11,9 +11,9 @@
 #include "semihost.h"
 
 #define FS 200.0f           /* sample rate [Hz] */
-#define OMEGA 1.04719755f   /* 60 deg/s [rad/s], seed 000's speed */
+#define OMEGA 1.04719755f   /* 60 deg/s [rad/s], the servo method's speed */
 #define N_TURN 1200         /* one 360 deg turn at 60 deg/s: 6 s */
-#define NOISE 0.035f        /* per-sample white noise [rad/s], seed 000's normal level */
+#define NOISE 0.035f        /* per-sample white noise [rad/s], the servo method's normal level */
 #define PAINT 0xC5C5C5C5u
 
 static const float K_TRUE[3] = {1.05f, 0.95f, 1.02f};
@@ -193,7 +193,7 @@ int main(void)
         gyrocal_accum_reset(&acc);
         for (int n = 0; n < N_TURN; ++n) {
             for (int i = 0; i < 3; ++i) {
-                sample[i] = s * dir[i] / K_TRUE[i] - B_TRUE[i] + noise(); /* seed 000 eq. 1, inverted */
+                sample[i] = s * dir[i] / K_TRUE[i] - B_TRUE[i] + noise(); /* the servo method of Wang et al., eq. 1, inverted */
             }
             if (o == 0 && n == 0) {
                 PAINT_STACK(sp0);

@@ -93,7 +93,7 @@ void gyrocal_scale_bias_to_affine(const gyrocal_scale_bias_t *sb, gyrocal_affine
     }
 }
 
-/* Position in K (seed 001, eq. 11) of the Kg elements 0..8 (eq. 14), as row * 3 + column. */
+/* Position in K (the full-temperature-range method, eq. 11) of the Kg elements 0..8 (eq. 14), as row * 3 + column. */
 static const uint8_t KG_SLOT[9] = {0, 4, 8, 1, 2, 3, 5, 6, 7};
 
 float gyrocal_temp_filter(float *state, float temp, float alpha)
@@ -125,12 +125,12 @@ gyrocal_status_t gyrocal_thermal_correct(const gyrocal_thermal_t *table, float t
     s = i - 2;
     s = s < 0 ? 0 : (s > n - 3 ? n - 3 : s);
     t += s;
-    /* seed 001, eq. 22: the three Lagrange basis values at temp */
+    /* the full-temperature-range method, eq. 22: the three Lagrange basis values at temp */
     w[0] = (temp - t[1]) * (temp - t[2]) / ((t[0] - t[1]) * (t[0] - t[2]));
     w[1] = (temp - t[2]) * (temp - t[0]) / ((t[1] - t[2]) * (t[1] - t[0]));
     w[2] = (temp - t[0]) * (temp - t[1]) / ((t[2] - t[0]) * (t[2] - t[1]));
     for (e = 0; e < 12; ++e) {
-        /* seed 001, eq. 21 */
+        /* the full-temperature-range method, eq. 21 */
         float v = w[0] * table->kg[s][e] + w[1] * table->kg[s + 1][e] + w[2] * table->kg[s + 2][e];
         if (e < 9) {
             k[KG_SLOT[e]] = v;
@@ -209,7 +209,7 @@ gyrocal_status_t gyrocal_accum_finish(const gyrocal_accum_t *acc, float rate, gy
     return GYROCAL_OK;
 }
 
-/* beta0 implied by beta (seed 000, eq. 3): sum beta_{j+3}^2 / (4 beta_j). */
+/* beta0 implied by beta (the servo method of Wang et al., eq. 3): sum beta_{j+3}^2 / (4 beta_j). */
 static float gamma_of(const float beta[N6])
 {
     return beta[3] * beta[3] / (4.0f * beta[0]) + beta[4] * beta[4] / (4.0f * beta[1])
@@ -221,7 +221,7 @@ static int k2_positive(const float beta[N6])
     return beta[0] > 0.0f && beta[1] > 0.0f && beta[2] > 0.0f;
 }
 
-/* Solve X u = Y and X v = 1 for the six-observation design (seed 000, eq. 6-7), with the
+/* Solve X u = Y and X v = 1 for the six-observation design (the servo method of Wang et al., eq. 6-7), with the
  * regressors (mean of squares, or squared mean, then mean) and Y = rate^2, all divided by
  * the largest rate r (or r^2) so that the pivot test and the stop rule do not depend on units. */
 static gyrocal_status_t six_solve(const gyrocal_obs_t obs[N6], int squared_mean, float u[N6], float v[N6],
@@ -259,7 +259,7 @@ static gyrocal_status_t six_solve(const gyrocal_obs_t obs[N6], int squared_mean,
     return GYROCAL_OK;
 }
 
-/* Seed 000's return step: k = sqrt(beta_1..3), b = beta_4..6 / (2 beta_1..3), undoing the rate scaling. */
+/* The servo method's return step: k = sqrt(beta_1..3), b = beta_4..6 / (2 beta_1..3), undoing the rate scaling. */
 static gyrocal_status_t finish_kb(const float beta[N6], float r, gyrocal_scale_bias_t *out)
 {
     float k[3], b[3];
@@ -293,7 +293,7 @@ gyrocal_status_t gyrocal_algorithm1(const gyrocal_obs_t obs[GYROCAL_N_OBS], gyro
     for (j = 0; j < N6; ++j) {
         beta[j] = u[j]; /* beta0 = 0: the initial estimate */
     }
-    /* beta(n+1) = X^-1 (Y - gamma(beta(n))) = u - gamma v, seed 000 Algorithm 1 */
+    /* beta(n+1) = X^-1 (Y - gamma(beta(n))) = u - gamma v, the servo method of Wang et al., Algorithm 1 */
     for (it = 1; it <= GYROCAL_MAX_ITER; ++it) {
         float g, delta = 0.0f, size = 0.0f;
         if (!k2_positive(beta)) {

@@ -9,8 +9,8 @@
  *     w_true = matrix * (raw - offset)
  *
  * raw and offset in the sensor's units, matrix maps them to the output units.
- * Seed 000 (eq. 1) writes g = diag(k) (m + b): matrix = diag(k), offset = -b.
- * Seed 001 (eq. 12) writes w = K w~ + B: matrix = K^-1, offset = B.
+ * The servo method of Wang et al. (eq. 1) writes g = diag(k) (m + b): matrix = diag(k), offset = -b.
+ * The full-temperature-range method (eq. 12) writes w = K w~ + B: matrix = K^-1, offset = B.
  *
  * Every function that can fail returns a gyrocal_status_t; on failure the
  * outputs are left untouched, so a caller never sees NaN parameters.
@@ -19,6 +19,11 @@
 #define GYROCAL_CAL_H
 
 #include <stdint.h>
+
+/* Version of this library's interface and table layout. Headers exported by gyrocal
+ * (gyrocal export --format c-header) check it, so a table never meets a library it was
+ * not made for; gyrocal.firmware.header.C_LIBRARY_VERSION holds the same number. */
+#define GYROCAL_CAL_VERSION 2
 
 #ifdef __cplusplus
 extern "C" {
@@ -33,14 +38,14 @@ typedef enum {
     GYROCAL_E_RANGE = 5        /* temperature outside the table and GYROCAL_THERMAL_CLAMP not given */
 } gyrocal_status_t;
 
-/* Six observations: the G-optimal design of seed 000 (+x, -x, +y, -y, +z, -z turns). */
+/* Six observations: the G-optimal design of the servo method of Wang et al. (+x, -x, +y, -y, +z, -z turns). */
 #define GYROCAL_N_OBS 6
 /* Relative pivot threshold of the 6x6 and 3x3 eliminations (on rate-normalised entries). */
 #ifndef GYROCAL_PIVOT_RTOL
 #define GYROCAL_PIVOT_RTOL 1e-5f
 #endif
 /* Stop when sum|delta beta| <= GYROCAL_REL_TOL * sum|beta| (beta normalised by the largest rate):
- * 16 float32 epsilons, the float32 stand-in for seed 000's absolute 1e-6. */
+ * 16 float32 epsilons, the float32 stand-in for the servo method's absolute 1e-6. */
 #ifndef GYROCAL_REL_TOL
 #define GYROCAL_REL_TOL 1.9073486e-06f
 #endif
@@ -54,13 +59,13 @@ typedef struct {
     float offset[3];
 } gyrocal_affine_t;
 
-/* Seed 000 parameters: g = diag(k) (m + b); b in the sensor's units, added to the reading. */
+/* Parameters of the servo method of Wang et al.: g = diag(k) (m + b); b in the sensor's units, added to the reading. */
 typedef struct {
     float k[3];
     float b[3];
 } gyrocal_scale_bias_t;
 
-/* Seed 001 temperature table: n >= 3 strictly increasing nodes [degC] and one Kg 12-vector per
+/* Temperature table of the full-temperature-range method: n >= 3 strictly increasing nodes [degC] and one Kg 12-vector per
  * node, eq. 14 order [Kxx,Kyy,Kzz,Kyx,Kzx,Kxy,Kzy,Kxz,Kyz,Bx,By,Bz]; K maps output units to
  * sensor units, B is in sensor units. */
 typedef struct {
@@ -94,10 +99,10 @@ typedef struct {
 /* w = matrix (raw - offset). */
 void gyrocal_correct(const gyrocal_affine_t *cal, const float raw[3], float out[3]);
 
-/* The canonical form of seed 000 parameters: matrix = diag(k), offset = -b. */
+/* The canonical form of the servo method's parameters (Wang et al.): matrix = diag(k), offset = -b. */
 void gyrocal_scale_bias_to_affine(const gyrocal_scale_bias_t *sb, gyrocal_affine_t *out);
 
-/* w = K(T)^-1 (raw - B(T)), Kg(T) by 3-node Lagrange interpolation (seed 001, eq. 21-22) over nodes
+/* w = K(T)^-1 (raw - B(T)), Kg(T) by 3-node Lagrange interpolation (the full-temperature-range method, eq. 21-22) over nodes
  * s, s+1, s+2 with s = clamp(i - 2, 0, n - 3) and i the first node >= T. */
 gyrocal_status_t gyrocal_thermal_correct(const gyrocal_thermal_t *table, float temp, const float raw[3],
                                          unsigned flags, float out[3]);
@@ -113,7 +118,7 @@ void gyrocal_accum_add(gyrocal_accum_t *acc, const float sample[3]);
 /* Window mean and mean of squares; `rate` is stored as the observation's reference. */
 gyrocal_status_t gyrocal_accum_finish(const gyrocal_accum_t *acc, float rate, gyrocal_obs_t *obs);
 
-/* Seed 000 Algorithm 1 on exactly six observations (regressors: means of squares and means). */
+/* The servo method of Wang et al., Algorithm 1 on exactly six observations (regressors: means of squares and means). */
 gyrocal_status_t gyrocal_algorithm1(const gyrocal_obs_t obs[GYROCAL_N_OBS], gyrocal_scale_bias_t *out,
                                     int *iterations);
 

@@ -1,13 +1,30 @@
-"""Command line: ``gyrocal``. Importing this module registers every command."""
+"""Command line: ``gyrocal``. Importing this module registers every command.
+
+Each command group lives in its own module (``*_cmds``); they never import each other,
+and shared pieces live in the ``_*`` helper modules. :data:`HELP_ORDER` is the one
+place that sets the order of ``gyrocal --help``.
+"""
 
 from __future__ import annotations
 
+import importlib
 import sys
 
+from . import app as _app_module
 from .app import app, run
-from . import calibrate_cmds, sim_cmds, thermal_cmds  # noqa: F401  (register commands)
 
-__all__ = ["app", "main"]
+__all__ = ["COMMAND_MODULES", "HELP_ORDER", "app", "main"]
+
+#: Modules that register commands (add yours here).
+COMMAND_MODULES = ("calibrate_cmds", "apply_cmds", "export_cmds", "thermal_cmds", "noise_cmds", "sim_cmds",
+                   "plan_cmds", "study_cmds")
+#: Order of the commands in ``gyrocal --help``; commands not listed follow by name.
+HELP_ORDER = ("calibrate", "segments", "apply", "export", "thermal", "thermal-report", "noise", "simulate", "plan",
+              "study")
+
+for _name in COMMAND_MODULES:
+    importlib.import_module(f"{__name__}.{_name}")
+_app_module.HELP_ORDER[:] = HELP_ORDER
 
 
 def main() -> None:

@@ -18,10 +18,27 @@ except ImportError:  # pragma: no cover - exercised only without the extra
     sys.stderr.write("gyrocal: the command line needs its extra: pip install 'gyrocal[cli]'\n")
     raise SystemExit(2) from None
 
-from ..errors import GyrocalError
+from typer.core import TyperGroup
+
+from ..errors import GyrocalError, GyrocalWarning
+from ._flags import flag
+
+#: Commands in the order ``gyrocal --help`` lists them; set once, in ``gyrocal.cli``.
+HELP_ORDER: list[str] = []
+
+
+class _OrderedGroup(TyperGroup):
+    """Lists commands in :data:`HELP_ORDER`, then any others by name."""
+
+    def list_commands(self, ctx):
+        names = super().list_commands(ctx)
+        rank = {name: i for i, name in enumerate(HELP_ORDER)}
+        return sorted(names, key=lambda n: (rank.get(n, len(rank)), n))
+
 
 app = typer.Typer(
     name="gyrocal",
+    cls=_OrderedGroup,
     help="Calibrate triaxial MEMS gyroscopes: servo-aided and full-temperature-range methods.",
     no_args_is_help=True,
     add_completion=False,
@@ -65,14 +82,29 @@ def _is_usage_error(exc: BaseException) -> bool:
     return hasattr(exc, "format_message") and hasattr(exc, "exit_code")
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """A library warning as one ``warning:`` line."""
+    warn(str(message))
+
+
+def message(exc: BaseException) -> str:
+    """The one line shown for a library or OS error; library parameters appear as their flags."""
+    if isinstance(exc, GyrocalError):
+        return exc.render(flag)
+    return f"{getattr(exc, 'strerror', None) or exc}: {getattr(exc, 'filename', None) or ''}".strip(": ")
+
+
 def run(argv: list[str] | None = None) -> int:
     """Run the CLI; map library, OS and usage errors to one line and exit code 2."""
     try:
-        rv = app(args=argv, standalone_mode=False)
+        with warnings.catch_warnings():
+            warnings.simplefilter("always", GyrocalWarning)
+            warnings.showwarning = _show_warning
+            rv = app(args=argv, standalone_mode=False)
     except (GyrocalError, OSError) as exc:
         if _state["debug"]:
             raise
-        fail(str(exc) if isinstance(exc, GyrocalError) else f"{exc.strerror or exc}: {exc.filename or ''}".strip(": "))
+        fail(message(exc))
         return 2
     except typer.Exit as exc:
         return exc.exit_code

@@ -1,4 +1,4 @@
-"""Commands ``thermal`` and ``thermal-report``: seed 001 from the command line.
+"""Commands ``thermal`` and ``thermal-report``: the full-temperature-range method from the command line.
 
 User units live here: ``--full-scale`` is in the data's unit; temperatures in degC.
 Library warnings (saturated steps, clamped temperatures) are printed as one line each.
@@ -6,34 +6,23 @@ Library warnings (saturated steps, clamped temperatures) are printed as one line
 
 from __future__ import annotations
 
-from enum import Enum
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Optional
 
-import numpy as np
 import typer
 
-from ..units import parse_input_unit, parse_rate_unit, unit_factor
+from ..choices import OutOfRange
+from ..errors import InputError
 from ._outputs import check_output, same_document
-from .app import app, console, fail, warnings_as_lines
+from ._reading import READING
+from .app import app, console, warnings_as_lines
 
 __all__ = ["thermal", "thermal_report"]
 
 
-class OutOfRangePolicy(str, Enum):
-    refuse = "refuse"
-    clamp = "clamp"
-    extrapolate = "extrapolate"
-
-
 Units = Annotated[str, typer.Option("--units", help="Unit of the gyro and table_rate columns: rad/s, deg/s or counts.")]
-Columns = Annotated[str | None, typer.Option(
-    "--columns", help="Map gyrocal names to the file's, e.g. gx=GX,temp=T,table_rate=RATE,axis=POS.")]
-SampleRate = Annotated[float | None, typer.Option("--sample-rate", help="Sample rate (Hz) when there is no t column.")]
-Sensitivity = Annotated[float | None, typer.Option("--sensitivity", help="For --units counts: LSB per --output-units.")]
-OutputUnits = Annotated[str | None, typer.Option("--output-units", help="Unit of corrected rates (default --units).")]
 Settle = Annotated[float, typer.Option("--settle", help="Time dropped at the start of every step (s).")]
-FullScale = Annotated[float | None, typer.Option(
+FullScale = Annotated[Optional[float], typer.Option(
     "--full-scale", help="Gyro range in the data's unit; steps with samples at it are left out (with a warning).")]
 TempTol = Annotated[float, typer.Option(
     "--temp-tolerance", help="Spread allowed inside a step, and closest distinct temperature points (degC).")]
@@ -41,16 +30,20 @@ TempTol = Annotated[float, typer.Option(
 
 def _units(units: str, output_units: str | None, sensitivity: float | None) -> tuple[str, str]:
     """(input unit of the table, output unit) for the command's flags."""
-    u = parse_input_unit(units, "--units")
+    from ..units import parse_input_unit, parse_rate_unit
+
+    u = parse_input_unit(units, "units")
     if u == "counts":
         if sensitivity is None or output_units is None:
-            raise fail("--units counts needs --sensitivity and --output-units (the physical unit of the counts)")
-        return parse_rate_unit(output_units, "--output-units"), parse_rate_unit(output_units, "--output-units")
-    return u, parse_rate_unit(output_units or u, "--output-units")
+            raise InputError("--units counts needs --sensitivity and --output-units (the physical unit of the counts)")
+        return parse_rate_unit(output_units, "output_units"), parse_rate_unit(output_units, "output_units")
+    return u, parse_rate_unit(output_units or u, "output_units")
 
 
 def _full_scale(value: float | None, units: str, rate_unit: str, sensitivity: float | None) -> float | None:
     """--full-scale in rad/s."""
+    from ..units import parse_input_unit, unit_factor
+
     if value is None:
         return None
     if parse_input_unit(units) == "counts":
@@ -59,7 +52,7 @@ def _full_scale(value: float | None, units: str, rate_unit: str, sensitivity: fl
 
 
 def _read(path: Path, units: str, columns, sample_rate, sensitivity, output_units):
-    from ..thermal import read_session
+    from ..io import read_session
 
     return read_session(path, units=units, columns=columns, sample_rate=sample_rate, sensitivity=sensitivity,
                         output_units=output_units, saturation="ignore")
@@ -70,10 +63,10 @@ def thermal(
     session: Annotated[Path, typer.Argument(help="Session: one CSV/Parquet/bag with every temperature point, or a folder.")],
     units: Units,
     output: Annotated[Path, typer.Option("-o", "--output", help="Thermal calibration file to write (JSON).")],
-    output_units: OutputUnits = None,
-    columns: Columns = None,
-    sample_rate: SampleRate = None,
-    sensitivity: Sensitivity = None,
+    output_units: READING.OutputUnits = None,
+    columns: READING.Columns = None,
+    sample_rate: READING.SampleRate = None,
+    sensitivity: READING.Sensitivity = None,
     settle: Settle = 2.0,
     full_scale: FullScale = None,
     temp_tolerance: TempTol = 2.0,
@@ -84,9 +77,9 @@ def thermal(
     force: Annotated[bool, typer.Option("--force", help="Replace an -o file that holds a different calibration.")]
     = False,
 ) -> None:
-    """Fit a temperature table (seed 001) from a turntable session."""
-    from ..thermal import calibrate_thermal, save_thermal
-    from ..thermal.model import to_document
+    """Fit a temperature table (the full-temperature-range method) from a turntable session."""
+    from ..files import save
+    from ..thermal import calibrate_thermal
 
     in_u, out_u = _units(units, output_units, sensitivity)
     check_output(output, inputs=(session,), force=True)  # what needs no fit: fail fast, before fitting
@@ -96,15 +89,18 @@ def thermal(
                                      full_scale=_full_scale(full_scale, units, out_u, sensitivity),
                                      temp_tolerance=temp_tolerance, reference_temp=ref_temp, max_order=max_order,
                                      temp_tau=temp_tau, names=names)
-    check_output(output, inputs=(session,), force=force, replaceable=same_document(to_document(cal)),
+    check_output(output, inputs=(session,), force=force, replaceable=same_document(cal.to_document()),
                  holds="a different calibration or another file")
-    save_thermal(cal, output)
+    save(cal, output)
     _print_table(cal, fit)
     console.print(f"wrote {output}")
 
 
 def _print_table(cal, fit) -> None:
+    import numpy as np
     from rich.box import SIMPLE
+
+    from ..units import unit_factor
     from rich.markup import escape
     from rich.table import Table
 
@@ -137,21 +133,20 @@ def thermal_report(
     calibration: Annotated[Path, typer.Argument(help="Thermal calibration file from 'gyrocal thermal'.")],
     test: Annotated[Path, typer.Argument(help="Test recording (or folder) with t, gx, gy, gz, temp, table_rate, axis.")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Report folder to write.")],
-    units: Annotated[str | None, typer.Option("--units", help="Unit of the test data (default: the calibration's input unit).")] = None,
-    columns: Columns = None,
-    sample_rate: SampleRate = None,
-    sensitivity: Sensitivity = None,
+    units: Annotated[Optional[str], typer.Option("--units", help="Unit of the test data (default: the calibration's input unit).")] = None,
+    columns: READING.Columns = None,
+    sample_rate: READING.SampleRate = None,
+    sensitivity: READING.Sensitivity = None,
     settle: Settle = 2.0,
     full_scale: FullScale = None,
     temp_tolerance: TempTol = 2.0,
-    out_of_range: Annotated[OutOfRangePolicy, typer.Option(
+    out_of_range: Annotated[OutOfRange, typer.Option(
         "--out-of-range", help="Test temperatures outside the calibrated range: refuse, clamp or extrapolate.")
-    ] = OutOfRangePolicy.refuse,
+    ] = "refuse",
     figures: Annotated[bool, typer.Option("--figures/--no-figures", help="Draw the PNG figures.")] = True,
 ) -> None:
     """Compare uncompensated, traditional, Lagrange and smooth compensation on a test recording."""
-    from ..errors import OutOfRangeError
-    from ..thermal import load_thermal
+    from ..files import load_thermal
     from ..thermal.evaluate import evaluate
     from ..thermal.report import write_report
 
@@ -160,11 +155,8 @@ def thermal_report(
     units = units or cal.input_units
     with warnings_as_lines():
         recs, _ = _read(test, units, columns, sample_rate, sensitivity, cal.output_units if units == "counts" else None)
-        try:
-            ev = evaluate(cal, recs, settle=settle, temp_tolerance=temp_tolerance, out_of_range=out_of_range.value,
-                          full_scale=_full_scale(full_scale, units, cal.output_units, sensitivity))
-        except OutOfRangeError as exc:  # name the flag, not the keyword
-            raise OutOfRangeError(str(exc).replace("pass out_of_range=", "pass --out-of-range ")) from None
+        ev = evaluate(cal, recs, settle=settle, temp_tolerance=temp_tolerance, out_of_range=out_of_range,
+                      full_scale=_full_scale(full_scale, units, cal.output_units, sensitivity))
         paths = write_report(cal, ev, output, figures=figures)
     from rich.markup import escape
     from rich.table import Table

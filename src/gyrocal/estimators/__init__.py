@@ -1,4 +1,4 @@
-"""Estimators of the seed 000 scale-bias model.
+"""Estimators of the scale-bias model of the servo method of Wang et al.
 
 Each estimator holds only its configuration; ``fit`` returns a frozen
 :class:`FitResult` and ``fit_batch`` a :class:`BatchFit` over many gyros.

@@ -2,7 +2,7 @@
 
 With six norm equations and six unknowns the least-squares solution makes every
 residual zero, so the weights drop out. Squaring ``|diag(k)(m_mean + b)| = rate`` gives
-seed 000's linear form (eq. 3-4) with window means in place of means of squares:
+the servo method's linear form (eq. 3-4) with window means in place of means of squares:
 
     X beta + beta0(beta) 1 = Y,   X_i = [m_mean_i^2, m_mean_i],   Y_i = rate_i^2.
 

@@ -3,22 +3,20 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
 
 import numpy as np
 
+from .._arrays import readonly
+from ..choices import Method
 from ..models import ScaleBias
 
 __all__ = ["BatchFit", "FitResult", "Method"]
 
-Method = Literal["first-moment", "algorithm1", "lm"]
 
 
 def _frozen(value, dtype=float) -> np.ndarray:
     """A read-only view of `value`: no copy of large batch arrays that already have `dtype`."""
-    arr = np.asarray(value, dtype=dtype).view()
-    arr.setflags(write=False)
-    return arr
+    return readonly(value, dtype, copy=False)
 
 
 @dataclass(frozen=True)
@@ -28,7 +26,7 @@ class BatchFit:
     Attributes
     ----------
     k, b : ndarray, shape (B, 3)
-        Seed 000 scale factors and biases [b in reading units].
+        Scale factors and biases of the servo method of Wang et al. [b in reading units].
     iterations : ndarray of int, shape (B,)
     converged : ndarray of bool, shape (B,)
     residuals : ndarray, shape (B, m)

@@ -1,4 +1,4 @@
-"""Seed 000 Algorithm 1: the iterative linear least-squares method, as published."""
+"""The servo method of Wang et al., Algorithm 1: the iterative linear least-squares method, as published."""
 
 from __future__ import annotations
 
@@ -65,7 +65,7 @@ def algorithm1_batch(obs: ObservationSet, *, tol: float = 1e-6, max_iter: int = 
 
 @dataclass(frozen=True)
 class Algorithm1:
-    """Seed 000 Algorithm 1 on the mean-of-squares regression (eq. 4–8).
+    """The servo method of Wang et al., Algorithm 1 on the mean-of-squares regression (eq. 4–8).
 
     Parameters
     ----------

@@ -5,7 +5,7 @@ Rotation windows give norm equations on the window mean,
     |diag(k) (m_mean + b)| = rate,                  rate = angle / T, or the known speed,
 
 and static windows give vector equations ``diag(k) (m_mean + b) = 0``. Squaring the
-window mean instead of averaging squares (seed 000 eq. 8) keeps the noise power out
+window mean instead of averaging squares (the servo method of Wang et al., eq. 8) keeps the noise power out
 of the equations, so the estimate is unbiased.
 
 Rows are weighted by the square root of the window's sample count (equal per-sample

@@ -1,4 +1,4 @@
-"""Levenberg–Marquardt on seed 000's regression model: the paper's comparison."""
+"""Levenberg–Marquardt on the servo method's regression model: the paper's comparison."""
 
 from __future__ import annotations
 
@@ -40,7 +40,7 @@ def paper_lm_batch(obs: ObservationSet, *, max_iter: int = 100) -> BatchFit:
 
 @dataclass(frozen=True)
 class PaperLM:
-    """Levenberg–Marquardt on the seed 000 model (eq. 4 with ``beta0`` tied to ``beta``)."""
+    """Levenberg–Marquardt on the model of the servo method of Wang et al. (eq. 4 with ``beta0`` tied to ``beta``)."""
 
     max_iter: int = 100
 

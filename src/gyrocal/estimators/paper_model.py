@@ -1,4 +1,4 @@
-"""Seed 000's linear regression form, shared by Algorithm 1 and its LM comparison.
+"""The servo method's linear regression form, shared by Algorithm 1 and its LM comparison.
 
 Eq. 4: ``y = beta0 + sum_j beta_j x_j`` with regressors ``x = (mean m^2, mean m)``
 per window (eq. 8), response ``y = omega^2``, and ``beta0 = sum beta_{j+3}^2 / (4 beta_j)``.

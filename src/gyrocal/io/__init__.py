@@ -5,9 +5,11 @@ MCAP bags (``ros`` extra). Everything comes back as a checked
 :class:`~gyrocal.recording.Recording` in internal units.
 """
 
+from .profile import read_profile
 from .reader import read_recording
-from .saturation import find_saturation
+from .session import read_session
+from ..saturation import find_saturation
 from .windowsfile import read_windows
-from .writer import write_csv
+from .writer import recording_columns, write_csv, write_recording
 
-__all__ = ["read_recording", "read_windows", "write_csv", "find_saturation"]
+__all__ = ["find_saturation", "read_profile", "read_recording", "read_session", "read_windows", "recording_columns", "write_csv", "write_recording"]

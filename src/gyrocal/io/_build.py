@@ -3,18 +3,17 @@
 from __future__ import annotations
 
 import math
-from typing import Literal
 
 import numpy as np
 
 from .._validation import positive
+from ..choices import AccelUnit, SaturationPolicy, values
 from ..errors import InputError, NonFiniteInputError, SaturationError, UnitError
 from ..recording import Recording
 from ..units import parse_input_unit, parse_rate_unit, unit_factor
-from ._columns import NUMERIC
-from .saturation import find_saturation, stuck_runs
+from ._columns import ACCEL, NUMERIC
+from ..saturation import find_saturation, stuck_runs
 
-SaturationPolicy = Literal["error", "drop", "ignore"]
 
 #: No MEMS gyro measures beyond about 2000 deg/s (4000 for a few); above this, rad/s is a unit mistake.
 MAX_PLAUSIBLE_RAD_S = math.radians(2000.0)
@@ -58,9 +57,13 @@ def _check_time(t: np.ndarray, source: str) -> float:
             f"{source}: {what} at data row {i + 2} (t={float(t[i])} then {float(t[i + 1])}); "
             "times must increase strictly: sort the log and drop repeated rows"
         )
-    # the median of up to 100 000 evenly spread steps: nominal, and cheap on long logs
+    # up to 100 000 evenly spread steps: nominal, and cheap on long logs. Their median, refined by the mean
+    # of the steps near it: stamps at epoch seconds (1.7e9 s) come in multiples of 0.24 us, so a 200 Hz
+    # step reads 4.99988 or 5.00012 ms and the median alone would pick one of them.
     i = np.linspace(0, len(t) - 2, min(len(t) - 1, 100_000)).astype(np.intp)
-    step = float(np.median(t[i + 1] - t[i]))
+    steps = t[i + 1] - t[i]
+    step = float(np.median(steps))
+    step = float(np.mean(steps[np.abs(steps - step) <= 1e-3 * step]))
     fs = 1.0 / step
     # ms or ns stamps under a plain name (t, time, timestamp) read as seconds; the 1e-6 slack
     # lets stamps at exactly 0.5 Hz or 100 kHz through despite rounding
@@ -144,6 +147,38 @@ def _rates_block(gx, gy, gz) -> np.ndarray:
     return np.array([gx, gy, gz], dtype=float).T
 
 
+#: Standard gravity [m/s^2], the default value of one g.
+STANDARD_GRAVITY = 9.80665
+
+
+def _accel_fields(data: dict, source: str, accel_units: str | None, accel_sensitivity: float | None,
+                  gravity: float) -> dict:
+    """The Recording's accelerometer fields from parsed ``ax, ay, az`` columns (none without `accel_units`)."""
+    if accel_units is None:
+        if any(c in data for c in ACCEL):
+            raise InputError(f"{source}: accelerometer columns are mapped but their unit is not given",
+                             param="accel_units", hint="give {param} m/s^2, g or counts")
+        if accel_sensitivity is not None:
+            raise UnitError("accel_sensitivity needs accel_units='counts'", param="accel_sensitivity")
+        return {}
+    unit = accel_units.strip().lower().replace("m/s2", "m/s^2").replace("m/s/s", "m/s^2")
+    if unit not in values(AccelUnit):
+        raise UnitError(f"{{param}}={accel_units!r} is not a known unit; use one of {', '.join(values(AccelUnit))}",
+                        param="accel_units", value=accel_units)
+    g0 = positive("gravity", gravity)
+    if accel_sensitivity is not None:
+        if unit != "counts":
+            raise UnitError(f"accel_sensitivity applies only to accel_units='counts', got {accel_units!r}",
+                            param="accel_sensitivity", value=accel_sensitivity)
+        accel_sensitivity = positive("accel_sensitivity", accel_sensitivity)
+    raw = np.array([data["ax"], data["ay"], data["az"]], dtype=float).T
+    if unit == "counts" and accel_sensitivity is None:
+        return {"accel": raw, "accel_units": "counts", "accel_source_units": "counts"}
+    factor = {"m/s^2": 1.0, "g": g0}.get(unit) or g0 / accel_sensitivity
+    return {"accel": raw * factor, "accel_units": "m/s^2", "accel_source_units": unit,
+            "accel_sensitivity": accel_sensitivity}
+
+
 def build_recording(
     data: dict,
     extra: dict,
@@ -156,8 +191,12 @@ def build_recording(
     check_units: bool = True,
     saturation: SaturationPolicy = "error",
     full_scale: float | None = None,
+    accel_units: str | None = None,
+    accel_sensitivity: float | None = None,
+    gravity: float = STANDARD_GRAVITY,
 ) -> Recording:
     """Check parsed columns and convert them to a :class:`Recording` (see :func:`gyrocal.io.read_recording`)."""
+    accel = _accel_fields(data, source, accel_units, accel_sensitivity, gravity)
     unit = parse_input_unit(units, "units")
     out_unit = parse_rate_unit(output_units, "output_units") if output_units is not None else "deg/s"
     if sensitivity is not None:
@@ -201,6 +240,7 @@ def build_recording(
         "table_rate": None if "table_rate" not in data else data["table_rate"] * table_factor,
         "axis": None if "axis" not in data else np.char.strip(np.asarray(data["axis"], dtype=str)),
         "extra": dict(extra),
+        **accel,
     }
     if keep is not None:
         fields = {k: (v[keep] if isinstance(v, np.ndarray) else v) for k, v in fields.items()}

@@ -11,9 +11,11 @@ from ..errors import InputError
 _EMPTY = {"", "na", "n/a", "null", "none", "nan", "-nan"}
 
 
-def to_float(values, column: str, source: str) -> np.ndarray:
+def to_float(values, column: str, source: str, *, decimal_comma: bool = False) -> np.ndarray:
     """Parse text cells into floats; empty or NA cells become NaN.
 
+    With `decimal_comma` (a table delimited by ``;``, TAB or spaces whose numbers are written
+    ``1,5``), a comma is the decimal mark and a point is refused: it could be a thousands separator.
     Row numbers in messages count data rows from 1 (the row after the header).
 
     Raises
@@ -25,6 +27,15 @@ def to_float(values, column: str, source: str) -> np.ndarray:
     raw[np.equal(raw, None)] = ""  # pyarrow gives None for empty text cells
     cells = np.char.strip(raw.astype(str))
     cells = np.where(np.isin(np.char.lower(cells), list(_EMPTY)), "nan", cells)
+    if decimal_comma:
+        pointed = np.char.find(cells, ".") >= 0
+        if pointed.any():
+            i = int(np.argmax(pointed))
+            raise InputError(
+                f"{source}: column {column!r} holds {str(cells[i])[:40]!r} at data row {i + 1}, but the table writes "
+                "decimal commas (1,5); a point there may be a thousands separator: write every number one way"
+            )
+        cells = np.char.replace(cells, ",", ".")
     try:
         return cells.astype(float)
     except ValueError:
@@ -40,11 +51,10 @@ def to_float(values, column: str, source: str) -> np.ndarray:
         raise
 
 
-
-def to_seconds(values, column: str, source: str) -> np.ndarray:
+def to_seconds(values, column: str, source: str, *, decimal_comma: bool = False) -> np.ndarray:
     """Parse a time column: numbers [s], or ISO 8601 date-times (seconds since the epoch)."""
     try:
-        return to_float(values, column, source)
+        return to_float(values, column, source, decimal_comma=decimal_comma)
     except InputError as exc:
         try:
             with warnings.catch_warnings():  # numpy warns on a 'Z' or offset suffix; it still reads UTC

@@ -7,11 +7,13 @@ from collections.abc import Mapping, Sequence
 
 from ..errors import InputError
 
+#: Accelerometer columns: read only when asked for (an accelerometer unit is given) or mapped by name.
+ACCEL = ("ax", "ay", "az")
 #: Canonical column names, in the order a recording uses them.
-CANONICAL = ("t", "gx", "gy", "gz", "temp", "table_rate", "axis")
+CANONICAL = ("t", "gx", "gy", "gz", "temp", "table_rate", "axis", *ACCEL)
 REQUIRED = ("gx", "gy", "gz")
 #: Columns parsed as numbers; ``axis`` is text.
-NUMERIC = ("t", "gx", "gy", "gz", "temp", "table_rate")
+NUMERIC = ("t", "gx", "gy", "gz", "temp", "table_rate", *ACCEL)
 
 _RATE_STEMS = ("g", "gyr", "gyro", "gyroscope", "w", "omega", "rate", "angularvelocity", "angvel", "av")
 _ALIASES: dict[str, set[str]] = {
@@ -25,6 +27,13 @@ _RATE_SUFFIXES = ("", "dps", "degs", "degps", "rads", "radps", "raw", "lsb")
 for _a in "xyz":
     _ALIASES[f"g{_a}"] = {f"{stem}{_a}{unit}" for stem in _RATE_STEMS for unit in _RATE_SUFFIXES} | {
         f"{_a}{stem}" for stem in ("gyr", "gyro", "rate")
+    }
+
+_ACCEL_STEMS = ("a", "acc", "accel", "accl", "acceleration", "accelerometer", "linacc", "linearacceleration", "la")
+_ACCEL_SUFFIXES = ("", "g", "ms2", "mss", "mps2", "raw", "lsb")
+for _a in "xyz":
+    _ALIASES[f"a{_a}"] = {f"{stem}{_a}{unit}" for stem in _ACCEL_STEMS for unit in _ACCEL_SUFFIXES} | {
+        f"{_a}{stem}" for stem in ("acc", "accel")
     }
 
 _BRACKETS = re.compile(r"[\(\[\{].*?[\)\]\}]")
@@ -62,11 +71,23 @@ def _found(names: Sequence[str]) -> str:
     return shown + (f", ... ({len(names)} in all)" if len(names) > 40 else "")
 
 
-def resolve(names: Sequence[str], columns: Mapping[str, str] | None, source: str) -> dict[str, str]:
+def _by_number(wanted: str, names: Sequence[str]) -> str | None:
+    """The column at position `wanted` counting from 1, when `wanted` is such a number."""
+    text = wanted.strip()
+    if text.isdigit() and 1 <= int(text) <= len(names):
+        return names[int(text) - 1]
+    return None
+
+
+def resolve(names: Sequence[str], columns: Mapping[str, str] | None, source: str, *, where: str = "",
+            header: bool = True, accel: bool = False) -> dict[str, str]:
     """Map canonical names to the file's column names.
 
-    Explicit `columns` win; then an exact canonical name (any case); then an alias, only
-    when a single file column matches it.
+    Explicit `columns` win, by name (exact, then in any case) or by position counting from 1
+    (``gx=2``; a column named ``2`` wins over the second column); then an exact canonical name
+    (any case); then an alias, only when a single file column matches it. A table without a
+    `header` (names ``"1" .. "n"``) is mapped by `columns` alone. The accelerometer columns
+    ``ax, ay, az`` are looked for only with `accel` (otherwise they stay other columns, unless mapped).
 
     Raises
     ------
@@ -78,15 +99,21 @@ def resolve(names: Sequence[str], columns: Mapping[str, str] | None, source: str
     by_lower = {}
     for n in names:
         by_lower.setdefault(n.strip().lower(), n)
+    found = f"columns found{' (' + where + ')' if where else ''}: {_found(names)}"
     mapping: dict[str, str] = {}
     for canon, wanted in parse_columns(columns).items():
-        hit = wanted if wanted in names else by_lower.get(wanted.strip().lower())
+        hit = wanted if wanted in names else by_lower.get(wanted.strip().lower()) or _by_number(wanted, names)
         if hit is None:
-            raise InputError(f"{source}: column {wanted!r} (given for {canon}) is not in the file; columns found: {_found(names)}")
+            raise InputError(f"{source}: column {wanted!r} (given for {canon}) is not in the file; {found}; "
+                             f"give a name or a number from 1 to {len(names)}")
+        if hit in mapping.values():
+            other = next(c for c, n in mapping.items() if n == hit)
+            raise InputError(f"{source}: column {hit!r} is given for both {other} and {canon}; each quantity needs "
+                             "its own column")
         mapping[canon] = hit
     taken = set(mapping.values())
-    for canon in CANONICAL:
-        if canon in mapping:
+    for canon in CANONICAL if header else ():
+        if canon in mapping or (canon in ACCEL and not accel):
             continue
         if canon in by_lower and by_lower[canon] not in taken:
             mapping[canon] = by_lower[canon]
@@ -96,17 +123,22 @@ def resolve(names: Sequence[str], columns: Mapping[str, str] | None, source: str
         if len(hits) == 1:
             mapping[canon] = hits[0]
             taken.add(hits[0])
-        elif len(hits) > 1 and (canon in REQUIRED or canon == "t"):
+        elif len(hits) > 1 and (canon in REQUIRED or canon == "t" or canon in ACCEL):
             raise InputError(
                 f"{source}: several columns could be {canon} ({_found(hits)}); "
                 f"say which with columns, e.g. --columns {canon}={hits[0]}"
             )
     missing = [c for c in REQUIRED if c not in mapping]
-    if missing:
+    accel_missing = [c for c in ACCEL if c not in mapping]
+    if (accel or len(accel_missing) < 3) and accel_missing and not missing:
         raise InputError(
-            f"{source}: no column for {', '.join(missing)}; columns found: {_found(names)}; "
-            "map them with --columns gx=NAME,gy=NAME,gz=NAME"
-        )
+            f"{source}: no accelerometer column for {', '.join(accel_missing)}; {found}",
+            param="columns", hint="map them with {param} ax=NAME,ay=NAME,az=NAME")
+    if missing:
+        how = ("by number, e.g. --columns gx=2,gy=3,gz=4" if not header else
+               "map them with --columns gx=NAME,gy=NAME,gz=NAME (or by number, gx=2), or, if the header is further "
+               "down, skip the lines above it (skip_rows=N)")
+        raise InputError(f"{source}: no column for {', '.join(missing)}; {found}; {how}")
     for canon, name in mapping.items():
         if names.count(name) > 1:  # readers would silently keep one of the copies
             raise InputError(

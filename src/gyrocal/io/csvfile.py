@@ -8,7 +8,10 @@ from __future__ import annotations
 
 import codecs
 import csv
+import io
+import lzma
 import os
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -16,38 +19,19 @@ import numpy as np
 from ..errors import InputError
 from ._cells import to_float, to_seconds
 from ._columns import NUMERIC, resolve, time_scale
+from ._layout import WHITESPACE, Layout, find_layout, split
+from ._source import arrow_input, compression, open_bytes
 
-__all__ = ["read_csv_columns", "sniff"]
+__all__ = ["read_csv_columns", "sniff", "WHITESPACE"]
 
 _HEAD_BYTES = 1 << 16
-_DELIMITERS = (",", ";", "\t", "|")
-WHITESPACE = None  # delimiter value meaning "runs of spaces or tabs"
-
-
-def _split(line: str, delimiter: str | None) -> list[str]:
-    if delimiter is WHITESPACE:
-        return line.split()
-    return [c.strip() for c in next(csv.reader([line], delimiter=delimiter))]
+_DECOMPRESS_ERRORS = (OSError, EOFError, zlib.error, lzma.LZMAError)
 
 
 def sniff(lines: list[str], source: str = "file") -> tuple[int, str | None]:
-    """Index of the header line and the delimiter of a text table.
-
-    Blank lines and ``#`` comment lines before the header are skipped. The delimiter is
-    the candidate (``, ; TAB |``) that splits the header into at least two fields and the
-    most of the next lines into as many; runs of whitespace when none splits the header.
-    """
-    h = next((i for i, line in enumerate(lines) if line.strip() and not line.lstrip().startswith("#")), None)
-    if h is None:
-        raise InputError(f"{source}: no header row (the file is empty or holds only comments)")
-    rows = [line for line in lines[h + 1:h + 21] if line.strip()]
-    best, best_score = WHITESPACE, (-1, 0)
-    for d in _DELIMITERS:
-        n = len(_split(lines[h], d))
-        score = (sum(len(_split(line, d)) == n for line in rows), n)
-        if n >= 2 and score > best_score:
-            best, best_score = d, score
-    return h, best
+    """Index of the header line and the delimiter of a text table (see :func:`find_layout`)."""
+    layout = find_layout(lines, source)
+    return (layout.data if layout.header is None else layout.header), layout.delimiter
 
 
 # UTF-32 first: its little-endian BOM starts with UTF-16's
@@ -55,34 +39,83 @@ _BOMS = ((codecs.BOM_UTF32_LE, "utf-32"), (codecs.BOM_UTF32_BE, "utf-32"),
          (codecs.BOM_UTF16_LE, "utf-16"), (codecs.BOM_UTF16_BE, "utf-16"))
 
 
-def _head(path: Path) -> tuple[list[str], str]:
-    """The first lines of a text table, and its encoding: UTF-8 unless a UTF-16/32 BOM says otherwise
-    (Excel's "Unicode text" is UTF-16); both readers decode that encoding, which drops the BOM."""
-    with open(path, "rb") as f:
-        raw = f.read(_HEAD_BYTES)
-    encoding = next((enc for bom, enc in _BOMS if raw.startswith(bom)), "utf-8-sig")
-    lines = raw.decode(encoding, errors="replace").splitlines()
-    return (lines[:-1] if len(raw) == _HEAD_BYTES and len(lines) > 1 else lines), encoding  # the last line may be cut
-
-
-def _is_number(cell: str) -> bool:
+def _head(path: Path, packed: str | None, skip_rows: int | None = None) -> tuple[list[str], str]:
+    """The first lines of a text table (64 KiB, and beyond `skip_rows` lines), and its encoding: UTF-8
+    unless a UTF-16/32 BOM says otherwise (Excel's "Unicode text" is UTF-16); both readers decode that
+    encoding, which drops the BOM."""
     try:
-        float(cell)
-    except ValueError:
-        return False
-    return True
+        with open_bytes(path, packed) as f:
+            raw = f.read(_HEAD_BYTES)
+            while skip_rows and raw.count(b"\n") <= skip_rows + 40 and (more := f.read(_HEAD_BYTES)):
+                raw += more
+    except _DECOMPRESS_ERRORS as exc:
+        raise InputError(f"{path.name}: cannot decompress it as {packed} ({exc})") from None
+    encoding = next((enc for bom, enc in _BOMS if raw.startswith(bom)), None)
+    if encoding is None and b"\x00" in raw:
+        packed_note = f" (after {packed} decompression)" if packed else ""
+        raise InputError(
+            f"{path.name}: binary data{packed_note}, not a text table; gyrocal reads delimited text (plain, or "
+            "gzip/bz2/xz/zstd/lz4/zip-compressed), Parquet and ROS 1/ROS 2/MCAP bags")
+    encoding = encoding or "utf-8-sig"
+    lines = raw.decode(encoding, errors="replace").splitlines()
+    return (lines[:-1] if len(raw) % _HEAD_BYTES == 0 and len(lines) > 1 else lines), encoding  # the last line may be cut
 
 
-def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool | None = None):
-    """Read a text table.
+def _headerless(path: Path, lines: list[str], layout: Layout) -> InputError:
+    """The refusal of a table without a header when no columns are given, with the mapping to type."""
+    first = lines[layout.data]
+    rows = [split(line, layout.delimiter) for line in lines[layout.data:layout.data + 50] if line.strip()]
+    try:
+        t = [float(r[0].replace(",", ".") if layout.decimal_comma else r[0]) for r in rows]
+        timed = len(layout.names) >= 4 and len(t) > 1 and all(b > a for a, b in zip(t, t[1:]))
+    except (ValueError, IndexError):
+        timed = False
+    numbers = "t=1,gx=2,gy=3,gz=4" if timed else "gx=1,gy=2,gz=3"
+    sep = layout.delimiter or " "
+    return InputError(
+        f"{path.name}: the first line ({first[:40].strip()!r}) is data, not a header; say which column holds what "
+        f"by number, counting from 1 (--columns {numbers}{'' if timed else ' with --sample-rate HZ'}), or add a "
+        f"header row naming the columns, e.g. {sep.join(('t', 'gx', 'gy', 'gz'))!r}"
+    )
+
+
+def _mapped(path: Path, lines: list[str], layout: Layout, columns, accel: bool = False) -> tuple[Layout, dict[str, str]]:
+    """The layout whose names hold the gyro columns (the first reading, else another one, e.g. the
+    header over a units row) and the mapping of canonical names to its columns."""
+    names = layout.names
+    if not columns and layout.header is not None and names == [str(i) for i in range(len(names))]:
+        raise InputError(
+            f"{path.name}: the header ({lines[layout.header][:40].strip()!r}) numbers the columns from 0, as pandas "
+            f"writes them; say which column holds what by those names, e.g. --columns t=0,gx=1,gy=2,gz=3"
+        )
+    error = None
+    for reading in (layout, *layout.others):
+        where = "no header row; columns count from 1" if reading.header is None else f"header on line {reading.header + 1}"
+        try:
+            return reading, resolve(reading.names, columns, path.name, where=where, header=reading.header is not None,
+                                    accel=accel)
+        except InputError as exc:
+            error = error or exc
+    raise error
+
+
+def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool | None = None,
+                     skip_rows: int | None = None, accel: bool = False):
+    """Read a text table, plain or compressed.
 
     Parameters
     ----------
     path : path-like
     columns : dict or str, optional
-        Canonical name -> file column (see :func:`gyrocal.io._columns.resolve`).
+        Canonical name -> file column, by name or by number counting from 1 (see
+        :func:`gyrocal.io._columns.resolve`). A table without a header needs it.
     use_pyarrow : bool, optional
         Force (True) or forbid (False) the pyarrow reader; default: when installed.
+    skip_rows : int, optional
+        Lines above the header (or the first data row) to skip; default: metadata lines are
+        found and skipped (see :func:`gyrocal.io._layout.find_layout`).
+    accel : bool
+        Look for the accelerometer columns ``ax, ay, az`` too.
 
     Returns
     -------
@@ -92,16 +125,13 @@ def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool
         Every other column -> array of text, in file order.
     """
     path = Path(path)
-    lines, encoding = _head(path)
-    h, delimiter = sniff(lines, path.name)
-    names = _split(lines[h], delimiter)
-    if not columns and all(_is_number(n) for n in names):  # mapped numeric names are a real header
-        sep = delimiter or " "
-        raise InputError(
-            f"{path.name}: the first line ({lines[h][:40].strip()!r}) is data, not a header; add a header row "
-            f"naming the columns, e.g. {sep.join(('t', 'gx', 'gy', 'gz'))!r} (t optional with --sample-rate)"
-        )
-    mapping = resolve(names, columns, path.name)
+    packed = compression(path)
+    lines, encoding = _head(path, packed, skip_rows)
+    layout = find_layout(lines, path.name, skip_rows)
+    if layout.header is None and not columns:
+        raise _headerless(path, lines, layout)
+    layout, mapping = _mapped(path, lines, layout, columns, accel)
+    names = layout.names
     if use_pyarrow is None:
         try:
             import pyarrow.csv  # noqa: F401
@@ -109,36 +139,43 @@ def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool
             use_pyarrow = True
         except ImportError:
             use_pyarrow = False
-    if use_pyarrow and delimiter is not WHITESPACE and len(set(names)) == len(names):
-        cols = _read_arrow(path, h, delimiter, names, mapping, encoding)
-    else:
-        cols = _read_python(path, h, delimiter, names, mapping, encoding)
+    try:
+        if use_pyarrow and layout.delimiter is not WHITESPACE and len(set(names)) == len(names):
+            cols = _read_arrow(path, packed, layout, mapping, encoding)
+        else:
+            cols = _read_python(path, packed, layout, encoding)
+    except _DECOMPRESS_ERRORS as exc:
+        raise InputError(f"{path.name}: cannot decompress it as {packed} ({exc})") from None
     numeric = {mapping[c] for c in NUMERIC if c in mapping}
     data = {c: cols[mapping[c]] for c in mapping}
     for c in mapping:
         if mapping[c] in numeric and data[c].dtype != np.float64:
-            data[c] = (to_seconds if c == "t" else to_float)(data[c], mapping[c], path.name)
+            data[c] = (to_seconds if c == "t" else to_float)(data[c], mapping[c], path.name,
+                                                             decimal_comma=layout.decimal_comma)
     if "t" in data and (scale := time_scale(mapping["t"])) != 1.0:
         data["t"] = data["t"] * scale
     extra = {n: cols[n] for n in names if n not in set(mapping.values()) and n in cols}
     return data, extra
 
 
-def _read_arrow(path: Path, h: int, delimiter: str, names: list[str], mapping: dict, encoding: str) -> dict:
+def _read_arrow(path: Path, packed: str | None, layout: Layout, mapping: dict, encoding: str) -> dict:
     import pyarrow as pa
     import pyarrow.csv as pcsv
 
+    names = layout.names
     numeric = [mapping[c] for c in NUMERIC if c in mapping]
 
     def read(as_float: bool, encoding: str = "utf8"):
         types = {n: (pa.float64() if as_float and n in numeric else pa.string()) for n in names}
-        return pcsv.read_csv(
-            path,
-            # our stripped names replace the header row; skip_rows=0 keeps pyarrow's parallel fast path
-            read_options=pcsv.ReadOptions(skip_rows=h, column_names=names, skip_rows_after_names=1, encoding=encoding),
-            parse_options=pcsv.ParseOptions(delimiter=delimiter, ignore_empty_lines=True),
-            convert_options=pcsv.ConvertOptions(column_types=types, strings_can_be_null=False),
-        )
+        with arrow_input(path, packed) as source:
+            return pcsv.read_csv(
+                source,
+                # our stripped names replace the header row
+                read_options=pcsv.ReadOptions(skip_rows=layout.data, column_names=names, encoding=encoding),
+                parse_options=pcsv.ParseOptions(delimiter=layout.delimiter, ignore_empty_lines=True),
+                convert_options=pcsv.ConvertOptions(column_types=types, strings_can_be_null=False,
+                                                    decimal_point="," if layout.decimal_comma else "."),
+            )
 
     # pyarrow reads UTF-8 (its BOM included) natively and transcodes anything else
     as_float, encoding = True, "utf8" if encoding == "utf-8-sig" else encoding
@@ -171,13 +208,14 @@ def _read_arrow(path: Path, h: int, delimiter: str, names: list[str], mapping: d
     return {n: cols[n] if n in cols else table.column(n).to_numpy() for n in names}
 
 
-def _read_python(path: Path, h: int, delimiter: str | None, names: list[str], mapping: dict, encoding: str) -> dict:
-    with open(path, encoding=encoding, errors="replace", newline="") as f:
-        lines = [line for line in f.read().splitlines()[h + 1:] if line.strip()]
-    if delimiter is WHITESPACE:
+def _read_python(path: Path, packed: str | None, layout: Layout, encoding: str) -> dict:
+    with io.TextIOWrapper(open_bytes(path, packed), encoding=encoding, errors="replace", newline="") as f:
+        lines = [line for line in f.read().splitlines()[layout.data:] if line.strip()]
+    if layout.delimiter is WHITESPACE:
         rows = [line.split() for line in lines]
     else:
-        rows = list(csv.reader(lines, delimiter=delimiter))
+        rows = list(csv.reader(lines, delimiter=layout.delimiter))
+    names = layout.names
     width = len(names)
     for i, row in enumerate(rows):
         if len(row) != width:

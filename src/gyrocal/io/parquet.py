@@ -28,7 +28,7 @@ def _as_float(column, name: str, source: str) -> np.ndarray:
     raise InputError(f"{source}: column {name!r} has type {column.type}, not numbers; map another column with --columns")
 
 
-def read_parquet_columns(path: str | os.PathLike, columns=None):
+def read_parquet_columns(path: str | os.PathLike, columns=None, *, accel: bool = False):
     """Read a Parquet file: ``(data, extra)`` as for :func:`gyrocal.io.csvfile.read_csv_columns`.
 
     A timestamp-typed time column becomes seconds since the epoch; a numeric one named
@@ -45,7 +45,7 @@ def read_parquet_columns(path: str | os.PathLike, columns=None):
     except Exception as exc:  # pyarrow raises several types for a damaged file
         raise InputError(f"{path.name}: not a readable Parquet file ({str(exc).splitlines()[0]})") from None
     names = list(table.column_names)
-    mapping = resolve(names, columns, path.name)
+    mapping = resolve(names, columns, path.name, accel=accel)
     data = {}
     for canon, name in mapping.items():
         column = table.column(name)

@@ -7,7 +7,8 @@ from pathlib import Path
 
 from ..errors import InputError
 from ..recording import Recording
-from ._build import SaturationPolicy, build_recording
+from ._build import STANDARD_GRAVITY, SaturationPolicy, build_recording
+from ._source import compression
 
 __all__ = ["read_recording", "TEXT_SUFFIXES", "BAG_SUFFIXES"]
 
@@ -27,6 +28,8 @@ def _kind(path: Path) -> str:
         return "bag"
     with open(path, "rb") as f:
         magic = f.read(13)
+    if compression(path) is not None:
+        return "text"  # a compressed table (.csv.gz, .csv.zst, ...)
     if magic.startswith(b"PAR1"):
         return "parquet"
     if magic.startswith((b"#ROSBAG V2.0", b"\x89MCAP", b"SQLite format")):
@@ -46,19 +49,27 @@ def read_recording(
     check_units: bool = True,
     saturation: SaturationPolicy = "error",
     full_scale: float | None = None,
+    skip_rows: int | None = None,
+    accel_units: str | None = None,
+    accel_sensitivity: float | None = None,
+    gravity: float = STANDARD_GRAVITY,
+    need_accel: bool = False,
 ) -> Recording:
     """Read a gyro recording from a file and check it.
 
     Parameters
     ----------
     path : path-like
-        A delimited text table (``.csv .txt .tsv .dat``), a ``.parquet`` file, a ROS 1
-        ``.bag``, a ROS 2 bag folder or its ``.db3`` / ``.mcap`` file. The format is
-        chosen by suffix, then by the file's first bytes.
+        A delimited text table (``.csv .txt .tsv .dat``, plain or compressed: gzip, bz2, xz,
+        zstd, lz4, brotli or a zip holding one file), a ``.parquet`` file, a ROS 1 ``.bag``, a
+        ROS 2 bag folder or its ``.db3`` / ``.mcap`` file. The format is chosen by suffix,
+        then by the file's first bytes.
     units : {"rad/s", "deg/s", "counts"}
         Unit of the rate columns as written in the file.
     columns : dict or str, optional
-        File column for each quantity, ``{"gx": "gyroX", ...}`` or ``"gx=gyroX,gy=gyroY"``.
+        File column for each quantity, ``{"gx": "gyroX", ...}`` or ``"gx=gyroX,gy=gyroY"``, by
+        name or by number counting from 1 (``"gx=2,gy=3,gz=4"``; a table without a header row
+        needs numbers).
         Quantities: ``t`` [s], ``gx gy gz``, ``temp`` [degC], ``table_rate`` (signed, rate
         units of the data), ``axis`` (x/y/z). Unmapped ones are found by name or by an
         unambiguous alias (``time``, ``gyr_x``, ``gyro_x``, ``wx``, ...).
@@ -81,6 +92,20 @@ def read_recording(
     full_scale : float, optional
         Sensor limit in the file's units; without it, saturation is recognised by runs
         of identical readings at the largest magnitude.
+    skip_rows : int, optional
+        Text tables: lines to skip above the header row (or above the first data row of a
+        table without a header). Default: metadata lines such as ``Fs,100`` are recognised
+        (fewer fields than the table, or not followed by data) and skipped.
+    accel_units : {"m/s^2", "g", "counts"}, optional
+        Unit of the accelerometer columns ``ax, ay, az`` (found by name or alias: ``acc_x``,
+        ``accel_x``, ``ax``, ..., or mapped with `columns`). Without it they are not read
+        (they pass through as other columns), unless mapped in `columns`, which is refused.
+    accel_sensitivity : float, optional
+        For ``accel_units="counts"``: LSB per g. Without it accelerometer counts stay counts.
+    gravity : float
+        One g [m/s^2], for ``g`` and for counts with a sensitivity (default 9.80665).
+    need_accel : bool
+        Refuse a call without `accel_units` (for commands that need the accelerometer).
 
     Returns
     -------
@@ -95,21 +120,30 @@ def read_recording(
     path = Path(path)
     if not path.exists():
         raise InputError(f"recording {str(path)!r} does not exist")
+    if need_accel and accel_units is None:
+        raise InputError(f"{path.name}: the accelerometer's unit is not given", param="accel_units",
+                         hint="give {param} m/s^2, g or counts (with the accelerometer sensitivity for counts)")
+    accel = accel_units is not None
     kind = _kind(path)
+    if skip_rows is not None:
+        if kind != "text":
+            raise InputError(f"skip_rows applies to text tables only; {path.name} is a {kind} file")
+        if isinstance(skip_rows, bool) or not isinstance(skip_rows, int) or skip_rows < 0:
+            raise InputError(f"skip_rows must be a whole number >= 0, got {skip_rows!r}")
     if kind == "bag":
         from .rosbag import read_bag_columns
 
         if columns:
             raise InputError("columns= does not apply to ROS bags (angular_velocity and header stamps are used)")
-        data, extra = read_bag_columns(path, topic)
+        data, extra = read_bag_columns(path, topic, accel=accel)
     elif kind == "parquet":
         from .parquet import read_parquet_columns
 
-        data, extra = read_parquet_columns(path, columns)
+        data, extra = read_parquet_columns(path, columns, accel=accel)
     else:
         from .csvfile import read_csv_columns
 
-        data, extra = read_csv_columns(path, columns)
+        data, extra = read_csv_columns(path, columns, skip_rows=skip_rows, accel=accel)
     return build_recording(
         data,
         extra,
@@ -121,4 +155,7 @@ def read_recording(
         check_units=check_units,
         saturation=saturation,
         full_scale=full_scale,
+        accel_units=accel_units,
+        accel_sensitivity=accel_sensitivity,
+        gravity=gravity,
     )

@@ -30,7 +30,7 @@ def _pick_topic(connections, topic: str | None, source: str) -> list:
     return chosen
 
 
-def read_bag_columns(path: str | os.PathLike, topic: str | None = None):
+def read_bag_columns(path: str | os.PathLike, topic: str | None = None, *, accel: bool = False):
     """Angular velocity and header stamps of one Imu topic.
 
     Parameters
@@ -39,12 +39,15 @@ def read_bag_columns(path: str | os.PathLike, topic: str | None = None):
         A ROS 1 ``.bag``, a ROS 2 bag folder, or its ``.db3`` / ``.mcap`` file.
     topic : str, optional
         Needed when several topics carry Imu messages.
+    accel : bool
+        Return the accelerometer readings too.
 
     Returns
     -------
     data : dict
         ``t`` [s] (header stamps; the bag's receive times when every stamp is zero) and
-        ``gx, gy, gz`` (``angular_velocity``, in whatever unit the publisher used).
+        ``gx, gy, gz`` (``angular_velocity``, in whatever unit the publisher used) and
+        with `accel`, ``ax, ay, az`` (``linear_acceleration``, m/s^2 by the message's definition).
     extra : dict
         Empty.
     """
@@ -54,7 +57,7 @@ def read_bag_columns(path: str | os.PathLike, topic: str | None = None):
     except ImportError:
         raise MissingDependencyError("reading ROS bags needs rosbags: pip install 'gyrocal[ros]'") from None
     path = Path(path)
-    stamps, logtimes, rates = [], [], []
+    stamps, logtimes, rates, accels = [], [], [], []
     try:
         with AnyReader([path], default_typestore=get_typestore(Stores.ROS2_HUMBLE)) as reader:
             chosen = _pick_topic(reader.connections, topic, path.name)
@@ -64,6 +67,8 @@ def read_bag_columns(path: str | os.PathLike, topic: str | None = None):
                 logtimes.append(logtime)
                 w = msg.angular_velocity
                 rates.append((w.x, w.y, w.z))
+                a = msg.linear_acceleration
+                accels.append((a.x, a.y, a.z))
     except InputError:
         raise
     except Exception as exc:  # rosbags' own errors: unreadable or unknown bag layout
@@ -72,5 +77,8 @@ def read_bag_columns(path: str | os.PathLike, topic: str | None = None):
     if len(ns) == 0:
         raise InputError(f"{path.name}: the Imu topic holds no messages")
     t = ns * 1e-9  # float64 keeps ~0.2 us at today's epoch: ample for IMU rates
-    g = np.asarray(rates, dtype=float)
-    return {"t": t, "gx": g[:, 0], "gy": g[:, 1], "gz": g[:, 2]}, {}
+    g, a = np.asarray(rates, dtype=float), np.asarray(accels, dtype=float)
+    data = {"t": t, "gx": g[:, 0], "gy": g[:, 1], "gz": g[:, 2]}
+    if accel:
+        data.update(ax=a[:, 0], ay=a[:, 1], az=a[:, 2])
+    return data, {}

@@ -1,4 +1,4 @@
-"""Atomic CSV output for ``apply`` and ``simulate``."""
+"""Atomic CSV output: columns, and whole recordings (``apply``, ``simulate``)."""
 
 from __future__ import annotations
 
@@ -9,8 +9,9 @@ import numpy as np
 
 from .._atomic import atomic_path
 from ..errors import InputError
+from ..units import unit_factor
 
-__all__ = ["write_csv"]
+__all__ = ["recording_columns", "write_csv", "write_recording"]
 
 
 def _columns(columns: dict) -> dict[str, np.ndarray]:
@@ -81,3 +82,46 @@ def _write_arrow(tmp, arrays: dict[str, np.ndarray], header_comment: str | None)
 
 def _quote(name: str) -> str:
     return f'"{name}"' if any(c in name for c in ',"\n') else name
+
+
+def recording_columns(rec, units: str | None = None) -> dict[str, np.ndarray]:
+    """The columns of a recording as gyrocal writes it, in order.
+
+    ``t`` [s] (only when the time came from the data), ``gx gy gz`` in `units`
+    (default ``rec.source_units``; raw counts stay counts), ``temp`` [degC], ``table_rate``
+    in the gyro's unit (deg/s beside raw counts), ``axis``, ``ax ay az`` [m/s^2] (raw
+    counts stay counts), then every other column unchanged.
+    """
+    if rec.units == "counts":
+        if units not in (None, "counts"):
+            raise InputError(f"the recording holds raw counts; it cannot be written in {units}", param="units")
+        gyro_factor, table_unit = 1.0, "deg/s"
+    else:
+        table_unit = units or rec.source_units
+        if table_unit == "counts":
+            raise InputError("the recording holds rates converted to rad/s; write them in rad/s or deg/s",
+                             param="units")
+        gyro_factor = unit_factor(table_unit)
+    cols: dict[str, np.ndarray] = {}
+    if rec.has_time:
+        cols["t"] = np.asarray(rec.t)
+    for i, name in enumerate(("gx", "gy", "gz")):
+        cols[name] = rec.gyro[:, i] / gyro_factor if gyro_factor != 1.0 else rec.gyro[:, i]
+    if rec.temp is not None:
+        cols["temp"] = rec.temp
+    if rec.table_rate is not None:
+        cols["table_rate"] = rec.table_rate / unit_factor(table_unit)
+    if rec.axis is not None:
+        cols["axis"] = rec.axis
+    if rec.accel is not None:
+        for i, name in enumerate(("ax", "ay", "az")):
+            cols[name] = rec.accel[:, i]
+    for name, value in rec.extra.items():
+        cols.setdefault(name, value)
+    return cols
+
+
+def write_recording(path: str | os.PathLike, rec, *, units: str | None = None,
+                    header_comment: str | None = None) -> None:
+    """Write a recording as CSV (:func:`recording_columns`), atomically, with an optional ``#`` comment."""
+    write_csv(path, recording_columns(rec, units), header_comment=header_comment)

@@ -4,3 +4,7 @@ Each module draws into a caller's matplotlib ``Axes`` or ``Figure`` and returns 
 artists it made; none touches pyplot's global state. Import the module you need,
 for example ``from gyrocal.plotting.calibration import calibration_figure``.
 """
+
+from .figure import new_figure, save_figure
+
+__all__ = ["new_figure", "save_figure"]

@@ -16,7 +16,7 @@ from ..calibration import Calibration
 from ..recording import Recording
 from ..units import RATE_UNITS, from_rad_s
 from ..windows import Window
-from ._mpl import new_figure
+from .figure import new_figure
 
 __all__ = ["calibration_figure", "display_rates", "plot_corrected", "plot_windows"]
 

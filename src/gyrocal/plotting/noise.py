@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from ._mpl import new_figure
+from .figure import new_figure
 
 __all__ = ["allan_deviation_plot", "allan_figure"]
 

@@ -1,4 +1,4 @@
-"""Figures of the simulation studies (seed 000 Fig. 2, 4, 5 and Table I; seed 001 Tables 3-4).
+"""Figures of the simulation studies (the servo method of Wang et al., Fig. 2, 4, 5 and Table I; the full-temperature-range method, Tables 3-4).
 
 Functions that draw on one ``Axes`` return the artists they made; the ``*_figure``
 helpers build a headless ``Figure`` from them.
@@ -10,7 +10,7 @@ from typing import Mapping
 
 import numpy as np
 
-from ._mpl import new_figure
+from .figure import new_figure
 
 __all__ = ["error_boxes", "error_box_figure", "mse_vs_speed", "mse_speed_figure", "convergence", "convergence_figure",
            "rms_by_temperature", "rms_by_temperature_figure"]
@@ -59,7 +59,7 @@ def error_boxes(ax, errors: np.ndarray, crb_std: np.ndarray | None = None, *, ti
 
 def error_box_figure(errors: Mapping[tuple[float, str], np.ndarray], crb: Mapping[float, np.ndarray] | None = None,
                      *, title: str = ""):
-    """Grid of :func:`error_boxes`: rows are noise levels, columns methods (seed 000 Fig. 2 / 5)."""
+    """Grid of :func:`error_boxes`: rows are noise levels, columns methods (the servo method of Wang et al., Fig. 2 / 5)."""
     noises = sorted({n for n, _ in errors})
     methods = list(dict.fromkeys(m for _, m in errors))
     fig = new_figure((3.6 * len(methods), 3.0 * len(noises)), layout="constrained")
@@ -76,7 +76,7 @@ def error_box_figure(errors: Mapping[tuple[float, str], np.ndarray], crb: Mappin
 
 
 def mse_vs_speed(ax, speeds, mse: np.ndarray, crb_var: np.ndarray | None = None, *, title: str = "") -> list:
-    """MSE of each parameter against servo speed (seed 000 eq. 9, Fig. 4), with the CRB dashed.
+    """MSE of each parameter against servo speed (the servo method of Wang et al., eq. 9, Fig. 4), with the CRB dashed.
 
     Parameters
     ----------
@@ -100,7 +100,7 @@ def mse_vs_speed(ax, speeds, mse: np.ndarray, crb_var: np.ndarray | None = None,
 
 def mse_speed_figure(speeds, mse: Mapping[tuple[float, str], np.ndarray], crb: Mapping[float, np.ndarray] | None = None,
                      *, title: str = ""):
-    """Rows: methods; columns: noise levels (seed 000 Fig. 4 (a) and (b)); CRB dashed."""
+    """Rows: methods; columns: noise levels (the servo method of Wang et al., Fig. 4 (a) and (b)); CRB dashed."""
     noises = sorted({n for n, _ in mse})
     methods = list(dict.fromkeys(m for _, m in mse))
     fig = new_figure((5.0 * len(noises), 3.4 * len(methods)), layout="constrained")
@@ -115,7 +115,7 @@ def mse_speed_figure(speeds, mse: Mapping[tuple[float, str], np.ndarray], crb: M
 
 
 def convergence(ax, history: np.ndarray, truth: np.ndarray, *, title: str = "") -> list:
-    """``|estimate - truth|`` of each parameter against iteration (seed 000 Table I).
+    """``|estimate - truth|`` of each parameter against iteration (the servo method of Wang et al., Table I).
 
     Parameters
     ----------
@@ -146,7 +146,7 @@ def convergence_figure(cases: Mapping[str, tuple[np.ndarray, np.ndarray]], *, ti
 
 def rms_by_temperature(ax, temps, rms: Mapping[str, "np.ndarray"], *, floor: float | None = None,
                        title: str = "") -> list:
-    """RMS compensation error against test temperature, one line per method (seed 001 Tables 3-4).
+    """RMS compensation error against test temperature, one line per method (the full-temperature-range method, Tables 3-4).
 
     Parameters
     ----------

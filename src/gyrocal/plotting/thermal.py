@@ -1,4 +1,4 @@
-"""Pictures of a temperature calibration (seed 001, Figures 4-9).
+"""Pictures of a temperature calibration (the full-temperature-range method, Figures 4-9).
 
 * :func:`plot_coefficients`: every Kg element against temperature, with the fitted
   points and their 1-sigma bars, the Lagrange table and the smooth model (Figures 4-6);
@@ -16,7 +16,7 @@ import numpy as np
 
 from ..models import KG_NAMES
 from ..units import unit_factor
-from ._mpl import new_figure
+from .figure import new_figure
 
 __all__ = ["METHOD_STYLE", "plot_coefficients", "plot_error_vs_rate", "plot_error_vs_temperature"]
 
@@ -73,7 +73,7 @@ def plot_coefficients(cal, fig=None, *, units: str | None = None, truth=None) ->
     for ax in axes[-3:]:
         ax.set_xlabel("temperature [degC]", fontsize=8)
     axes[0].legend(fontsize=7)
-    fig.suptitle("Kg elements against temperature (seed 001 eq. 14)")
+    fig.suptitle("Kg elements against temperature (the full-temperature-range method, eq. 14)")
     return out
 
 

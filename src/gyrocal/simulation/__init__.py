@@ -3,7 +3,7 @@
 Readings from :func:`simulate_servo`, :func:`simulate_turntable` and
 :func:`simulate_profile` are :class:`~gyrocal.recording.Recording` objects, so simulated
 and real data travel one path. :func:`paper_observations` (per sample) and
-:func:`simulate_observations` (exact fast path) draw seed 000's window statistics.
+:func:`simulate_observations` (exact fast path) draw the servo method's window statistics.
 """
 
 from .fast import simulate_observations

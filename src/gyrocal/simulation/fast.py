@@ -1,6 +1,6 @@
 """Exact window statistics without drawing every sample (the fast path).
 
-Inside a constant-speed window the per-sample generator of seed 000's simulation
+Inside a constant-speed window the per-sample generator of the servo method's simulation
 (:func:`gyrocal.simulation.windows.paper_observations`) produces readings
 
     m_i = c + j_i d + e_i,        i = 1..n,
@@ -129,7 +129,7 @@ def simulate_observations(
     rng: np.random.Generator,
     fast: bool = True,
 ) -> ObservationSet:
-    """Seed 000's six-observation protocol for a batch of gyros, by the fast path.
+    """The servo method's six-observation protocol for a batch of gyros, by the fast path.
 
     Same parameters and law as :func:`gyrocal.simulation.windows.paper_observations`
     (the per-sample reference), which is called instead when ``fast`` is False. The

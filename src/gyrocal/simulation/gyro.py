@@ -1,7 +1,7 @@
 """A virtual triaxial gyroscope: deterministic errors, noise, quantisation, saturation.
 
-Readings follow seed 001 eq. 12, ``m = K(T) w + B(T) + noise``, which covers the
-seed 000 model too (``K = diag(1/k)``, ``B = -b``).
+Readings follow the full-temperature-range method, eq. 12, ``m = K(T) w + B(T) + noise``, which covers the
+the model of the servo method of Wang et al. too (``K = diag(1/k)``, ``B = -b``).
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ class VirtualGyro:
         True deterministic errors at the reference temperature; ignored where
         `thermal` is given.
     noise_std : float or array_like of shape (3,)
-        Per-sample white noise [rad/s] (seed 000 uses 0.035 and 0.2).
+        Per-sample white noise [rad/s] (the servo method of Wang et al. simulates 0.035 and 0.2).
     bias_instability : float
         Standard deviation of a first-order Gauss–Markov bias [rad/s]; 0 for none.
     bias_tau : float

@@ -2,12 +2,11 @@
 
 A profile is either a callable ``rates(t) -> (N, 3)`` [rad/s] of time [s], or
 tabulated samples ``(t, w)``, linearly interpolated onto the gyro's sample times
-(for example read from a CSV of ``t, wx, wy, wz`` with :func:`read_profile`).
+(for example read from a CSV of ``t, wx, wy, wz`` with :func:`gyrocal.io.read_profile`).
 """
 
 from __future__ import annotations
 
-import os
 from typing import Callable, Union
 
 import numpy as np
@@ -17,7 +16,7 @@ from ..errors import InputError
 from ..recording import Recording
 from .gyro import VirtualGyro
 
-__all__ = ["RateProfile", "profile_rates", "simulate_profile", "read_profile"]
+__all__ = ["RateProfile", "profile_rates", "simulate_profile"]
 
 RateProfile = Union[Callable[[np.ndarray], np.ndarray], tuple[np.ndarray, np.ndarray]]
 
@@ -84,14 +83,3 @@ def simulate_profile(
     temps = None if temp is None else np.broadcast_to(temp(t) if callable(temp) else float(temp), (n,)).astype(float)
     m = gyro.measure(w, fs, rng, temp=temps)
     return Recording(t=t, gyro=m, sample_rate=fs, temp=temps), w
-
-
-def read_profile(path: str | os.PathLike, *, units: str = "rad/s") -> tuple[np.ndarray, np.ndarray]:
-    """Read a profile CSV with columns ``t, wx, wy, wz`` (header row) into ``(t [s], w [rad/s])``."""
-    from ..io.csvfile import read_csv_columns
-    from ..units import to_rad_s
-
-    cols, _ = read_csv_columns(path)
-    if "t" not in cols:
-        raise InputError(f"{os.fspath(path)}: a rate profile needs a time column 't' [s]")
-    return np.asarray(cols["t"], float), to_rad_s(np.stack([cols["gx"], cols["gy"], cols["gz"]], axis=1), units)

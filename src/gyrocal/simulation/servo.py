@@ -1,11 +1,11 @@
-"""Servo and hand-turn sessions: the motion of seed 000's protocol (Fig. 1), simulated.
+"""Servo and hand-turn sessions: the motion of the servo method's protocol (Fig. 1), simulated.
 
 A session is a static lead-in, a sequence of turns about body axes separated by
 static waits, and a static lead-out. Every turn is built as a turn *angle* sampled at
 the sample boundaries, so the rates integrate (rectangle rule, ``sum(rate) / fs``)
 to exactly ``360 * revolutions`` degrees whatever the ramps, vibration or pauses.
 
-Servo vibration (seed 000, Fig. 7-8) is modelled as a bounded *angle* error of a
+Servo vibration (the servo method of Wang et al., Fig. 7-8) is modelled as a bounded *angle* error of a
 position-controlled servo: a periodic part at ``vibration_freq`` plus a random part,
 tapered to zero at both ends of each turn. Its derivative is the speed jitter, and
 the mean speed over a plateau stays the commanded one up to ``error / duration``.
@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._arrays import readonly
 from .._validation import positive
 from ..errors import InputError
 from ..models import CalibrationModel
@@ -28,7 +29,7 @@ from .windows import PAPER_AXES, axis_vector
 
 __all__ = ["PAPER_TURNS", "ServoProtocol", "ServoTruth", "simulate_servo"]
 
-#: Seed 000, Fig. 1: clockwise and counter-clockwise about x, y and z.
+#: The servo method of Wang et al., Fig. 1: clockwise and counter-clockwise about x, y and z.
 PAPER_TURNS: tuple[str, ...] = PAPER_AXES
 
 
@@ -46,20 +47,20 @@ class ServoProtocol:
     Parameters
     ----------
     speed : float
-        Plateau speed of every turn [rad/s] (seed 000: 60 deg/s).
+        Plateau speed of every turn [rad/s] (the servo method of Wang et al.: 60 deg/s).
     turns : tuple of str
         Turns in order, each ``+x``, ``-x``, ``+y``, ``-y``, ``+z`` or ``-z``; repeats allowed.
     revolutions : float
         Revolutions per turn; each turn turns exactly ``2 pi revolutions`` [rad].
     wait : float or tuple of float
-        Static time between turns [s] (seed 000: 3 s); a tuple gives one per gap.
+        Static time between turns [s] (the servo method of Wang et al.: 3 s); a tuple gives one per gap.
     lead_in, lead_out : float
         Static time before the first and after the last turn [s].
     ramp : float
         Acceleration (and deceleration) time of each turn or turn piece [s]; 0 = instant.
     vibration : float
         RMS speed jitter as a fraction of `speed`, half periodic at `vibration_freq`,
-        half random (servo vibration, seed 000 Fig. 7-8).
+        half random (servo vibration, the servo method of Wang et al., Fig. 7-8).
     vibration_freq : float
         Frequency of the periodic jitter [Hz].
     misalignment_deg : float
@@ -233,7 +234,7 @@ def simulate_servo(
     protocol : ServoProtocol
         The motion.
     sample_rate : float
-        Sampling rate [Hz] (seed 000: 200 Hz).
+        Sampling rate [Hz] (the servo method of Wang et al.: 200 Hz).
     rng : numpy.random.Generator
         Source of all randomness (mounting axis, vibration, unevenness, sensor noise).
 
@@ -287,6 +288,5 @@ def simulate_servo(
     true = np.concatenate(chunks)
     rec = Recording(t=np.arange(len(true)) / fs, gyro=gyro.measure(true, fs, rng), units="rad/s",
                     source_units="rad/s", sample_rate=fs)
-    true.setflags(write=False)
-    mounting.setflags(write=False)
-    return rec, ServoTruth(true, tuple(windows), tuple(plateaus), gyro.model, mounting)
+    return rec, ServoTruth(readonly(true, copy=False), tuple(windows), tuple(plateaus), gyro.model,
+                           readonly(mounting, copy=False))

@@ -1,9 +1,9 @@
-"""A temperature-dependent true gyro shaped like seed 001's Figures 4-6.
+"""A temperature-dependent true gyro shaped like the full-temperature-range method's Figures 4-6.
 
 * scale factors (Kxx, Kyy, Kzz) linear in temperature (Figure 4);
 * misalignment (off-diagonal K) constant (Figure 5);
 * biases a smooth nonlinear (cubic) function of temperature (Figure 6);
-* at the reference temperature, exactly seed 001's eq. 23 vector (biases in deg/s there).
+* at the reference temperature, exactly the full-temperature-range method's eq. 23 vector (biases in deg/s there).
 
 The default slopes and bias curves are our choice of plausible magnitudes (the
 paper's figures give shapes, not numbers).
@@ -21,7 +21,7 @@ from ..errors import InputError
 
 __all__ = ["EQ23_KG", "ThermalTruth", "eq23_kg"]
 
-#: Seed 001 eq. 23: Kg at 25 degC in eq. 14 order; the last three (biases) in deg/s.
+#: The full-temperature-range method, eq. 23: Kg at 25 degC in eq. 14 order; the last three (biases) in deg/s.
 EQ23_KG: tuple[float, ...] = (1.0005, 1.0005, 1.0017, -0.0188, 0.0012, 0.0187,
                               5.2027e-4, -0.0011, -7.5133e-4, -0.0303, -0.0435, -0.0261)
 
@@ -81,6 +81,12 @@ class ThermalTruth:
 
     def __call__(self, temp) -> tuple[np.ndarray, np.ndarray]:
         """``(K (N, 3, 3), B (N, 3) [rad/s])`` at temperatures (N,) [degC], for ``VirtualGyro(thermal=...)``."""
-        from ..thermal.model import kg_to_kb
+        from ..models import kg_to_kb
 
         return kg_to_kb(self.kg(temp))
+
+    def to_dict(self) -> dict:
+        """The truth's settings as plain JSON values (for a truth document)."""
+        return {"ref_temp": self.ref_temp, "kg_ref": [float(v) for v in self.kg_ref],
+                "scale_slope": [float(v) for v in self.scale_slope],
+                "bias_poly_deg_s": [[float(v) for v in row] for row in self.bias_poly]}

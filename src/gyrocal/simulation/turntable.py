@@ -1,4 +1,4 @@
-"""A single-axis, temperature-controlled turntable running seed 001's protocol.
+"""A single-axis, temperature-controlled turntable running the full-temperature-range method's protocol.
 
 At every temperature of Table 1 (after the soak, which is not recorded) the gyro is
 mounted with x, y, then z up along the table axis, and the table runs each rate of
@@ -9,20 +9,21 @@ analysis removes with its settling time.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from .._validation import positive
+from .._validation import at_least, positive
 from ..errors import InputError
 from ..recording import Recording
 from .gyro import VirtualGyro
 
 __all__ = ["TABLE1_TEMPS", "TABLE2_RATES", "TurntableProtocol", "simulate_turntable"]
 
-#: Seed 001 Table 1 [degC].
+#: The full-temperature-range method, Table 1 [degC].
 TABLE1_TEMPS: tuple[float, ...] = (-40.0, -30.0, -20.0, -10.0, 0.0, 10.0, 20.0, 30.0, 40.0, 50.0)
-#: Seed 001 Table 2 [deg/s], each non-zero rate run forward and reverse.
+#: The full-temperature-range method, Table 2 [deg/s], each non-zero rate run forward and reverse.
 TABLE2_RATES: tuple[float, ...] = (0.0, 0.1, 1.0, 10.0, 50.0, 100.0, 150.0, 200.0, 250.0, 300.0, 400.0)
 
 
@@ -60,10 +61,19 @@ class TurntableProtocol:
         positive("step_duration", self.step_duration)
         if not set(self.axes) <= {"x", "y", "z"} or not self.axes:
             raise InputError(f"axes must be drawn from 'x', 'y', 'z', got {self.axes!r}")
-        if not self.temps or not self.rates:
-            raise InputError("temps and rates must not be empty")
-        if self.table_tau < 0 or self.temp_noise < 0:
-            raise InputError("table_tau and temp_noise must be >= 0")
+        for name in ("temps", "rates"):
+            values = tuple(float(v) for v in getattr(self, name))
+            if not values or not all(math.isfinite(v) for v in values):
+                raise InputError(f"{{param}} must be one or more finite numbers, got {getattr(self, name)!r}",
+                                 param=name)
+            object.__setattr__(self, name, values)
+        if min(self.rates) < 0:
+            raise InputError(f"{{param}} are magnitudes >= 0 deg/s (each runs forward and reverse), got "
+                             f"{list(self.rates)}", param="rates", value=self.rates)
+        at_least("table_tau", self.table_tau, 0.0, " s")
+        at_least("temp_noise", self.temp_noise, 0.0, " degC")
+        if self.temp_quantum is not None:
+            positive("temp_quantum", self.temp_quantum)
 
     def signed_rates(self) -> np.ndarray:
         """Commanded rates of one position [rad/s]: each magnitude forward then reverse."""

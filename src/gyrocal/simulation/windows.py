@@ -1,7 +1,7 @@
-"""Per-sample simulation of seed 000's six-observation protocol, reduced to windows.
+"""Per-sample simulation of the servo method's six-observation protocol, reduced to windows.
 
 This is the reference generator: it draws every sample, then reduces each window
-exactly as :func:`gyrocal.observe` would. It follows seed 000, section III-A:
+exactly as :func:`gyrocal.observe` would. It follows the servo method of Wang et al., section III-A:
 
 * readings ``m = g / k - b + noise`` (eq. 1 solved for ``m``), white Gaussian noise;
 * one full revolution per axis and sense (Fig. 1) at ``speed``, ``n = round(2 pi / speed * fs)``
@@ -99,7 +99,7 @@ def paper_observations(
     Parameters
     ----------
     k, b : array_like, shape (B, 3) or (3,)
-        True scale factors [-] and biases [rad/s] (seed 000 eq. 1).
+        True scale factors [-] and biases [rad/s] (the servo method of Wang et al., eq. 1).
     speed : float
         Servo speed [rad/s] (the paper: 60 deg/s = pi/3).
     sample_rate : float

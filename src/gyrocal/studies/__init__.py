@@ -7,14 +7,14 @@ Each study is one module with ``run(out, ..., progress=None) -> StudyOutput`` an
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Literal, get_args
+from typing import get_args
 
 from ..errors import InputError
+from ..choices import StudyName
 from ._common import Progress, ServoSettings, StudyOutput
 
 __all__ = ["StudyName", "STUDY_NAMES", "run_study", "study_units", "StudyOutput", "ServoSettings"]
 
-StudyName = Literal["servo-normal", "servo-extreme", "servo-speed", "servo-convergence", "thermal-compare"]
 STUDY_NAMES: tuple[str, ...] = get_args(StudyName)
 
 
@@ -64,7 +64,7 @@ def run_study(
     seed : int
         Seed of the random generator.
     settings : ServoSettings, optional
-        Servo simulation settings (seed 000 studies; thermal-compare takes ``sample_rate``
+        Servo simulation settings (studies of the servo method of Wang et al.; thermal-compare takes ``sample_rate``
         and ``noise`` as options).
     progress : callable, optional
         ``progress(advance, label)`` after each unit of work.
@@ -76,7 +76,7 @@ def run_study(
         if value is not None and (int(value) != value or value < 1):
             raise InputError(f"--{label} must be a positive integer, got {value!r}")
     if name == "servo-convergence" and gyros is not None:
-        raise InputError("servo-convergence calibrates seed 000 Table I's three fixed gyros; --gyros does not apply")
+        raise InputError("servo-convergence calibrates the servo method of Wang et al., Table I's three fixed gyros; --gyros does not apply")
     sizes = {key: int(v) for key, v in (("gyros", gyros), ("reps", reps)) if v is not None}
     common = dict(seed=seed, progress=progress, **options)
     out = Path(out)

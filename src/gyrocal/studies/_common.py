@@ -1,4 +1,4 @@
-"""Settings, truth draws and outputs shared by the seed 000 studies."""
+"""Settings, truth draws and outputs shared by the studies of the servo method of Wang et al."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from ..observations import ObservationSet
 #: ``progress(advance, label)``: called after each unit of work with how many units it was.
 Progress = Callable[[int, str], None]
 
-#: Seed 000 section III-A: 200 Hz, 60 deg/s, 5 % jitter, misalignment up to 0.10, two noise levels.
+#: The servo method of Wang et al., section III-A: 200 Hz, 60 deg/s, 5 % jitter, misalignment up to 0.10, two noise levels.
 PAPER_SPEED = math.pi / 3.0
 PAPER_NOISE = (0.035, 0.2)
 PARAM_NAMES = ("kx", "ky", "kz", "bx", "by", "bz")
@@ -25,7 +25,7 @@ Condition = Literal["normal", "extreme"]
 
 @dataclass(frozen=True)
 class ServoSettings:
-    """Simulation settings of seed 000 section III [SI units]."""
+    """Simulation settings of the servo method of Wang et al., section III [SI units]."""
 
     speed: float = PAPER_SPEED
     sample_rate: float = 200.0
@@ -53,7 +53,7 @@ class StudyOutput:
 
 
 def draw_truth(condition: Condition, gyros: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-    """True ``(k, b)``, each (gyros, 3), from seed 000's ranges.
+    """True ``(k, b)``, each (gyros, 3), from the servo method's ranges.
 
     ``normal`` (III-A): k ~ U(0.8, 1.2), b ~ U(-0.1, 0.1) rad/s.
     ``extreme`` (III-C): k ~ U(1.2, 2.0), |b| ~ U(0.1, 0.2) rad/s with a random sign.

@@ -1,4 +1,4 @@
-"""The Cramér–Rao bound of seed 000's protocol, from the core's design module."""
+"""The Cramér–Rao bound of the servo method's protocol, from the core's design module."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Seed 000 Table I: Algorithm 1's estimates iteration by iteration, for three gyros.
+"""The servo method of Wang et al., Table I: Algorithm 1's estimates iteration by iteration, for three gyros.
 
 The true parameters are the paper's own "actual values" of its three cases (high
 scale error; high bias; both). Each case is calibrated once, showing every iterate,
@@ -17,7 +17,7 @@ from ..simulation.fast import simulate_observations
 from ._common import PARAM_NAMES, Progress, ServoSettings, StudyOutput
 from ._tables import write_table
 
-#: Seed 000 Table I, "Actual value" rows: (kx, ky, kz, bx, by, bz).
+#: The servo method of Wang et al., Table I, "Actual value" rows: (kx, ky, kz, bx, by, bz).
 PAPER_CASES = {
     "1. high scale factor error": (1.9074, 1.9529, 1.5635, 0.0827, 0.0265, -0.0805),
     "2. high bias": (1.0979, 1.1052, 0.9851, -0.1046, 0.1995, 0.1565),
@@ -71,10 +71,10 @@ def run(
     files += write_table(out / "iterations", ["case", "calibrations", "mean iterations", "max iterations",
                                               "iterations:count"], count_rows)
     if plot:
-        from ..plotting._mpl import save_figure
+        from ..plotting import save_figure
         from ..plotting.studies import convergence_figure
 
-        save_figure(convergence_figure(cases, title="seed 000 Table I: Algorithm 1 iterates"), out / "convergence.png")
+        save_figure(convergence_figure(cases, title="the servo method of Wang et al., Table I: Algorithm 1 iterates"), out / "convergence.png")
         files.append(out / "convergence.png")
     summary = "; ".join(f"{r[0]}: mean {r[2]:.2f}, max {r[3]} iterations" for r in count_rows)
     return StudyOutput("servo-convergence", tuple(files), summary)

@@ -1,4 +1,4 @@
-"""Seed 000 Fig. 2 and Fig. 5: error box plots of three estimators at two noise levels.
+"""The servo method of Wang et al., Fig. 2 and Fig. 5: error box plots of three estimators at two noise levels.
 
 ``servo-normal`` uses the normal parameter ranges (section III-A), ``servo-extreme``
 the extreme ones (section III-C). Each of ``gyros`` random gyros is calibrated
@@ -38,7 +38,7 @@ def run(
     out : Path
         Output folder.
     condition : {"normal", "extreme"}
-        Seed 000's parameter ranges.
+        The servo method's parameter ranges.
     gyros, reps : int
         Simulated gyros, and calibrations of each (paper: 30 x 500).
     seed : int
@@ -71,10 +71,10 @@ def run(
               "CRB std"]
     files = list(write_table(out / "errors", header, rows))
     if plot:
-        from ..plotting._mpl import save_figure
+        from ..plotting import save_figure
         from ..plotting.studies import error_box_figure
 
-        fig = error_box_figure(errors, crb, title=f"seed 000 Fig. {2 if condition == 'normal' else 5} "
+        fig = error_box_figure(errors, crb, title=f"the servo method of Wang et al., Fig. {2 if condition == 'normal' else 5} "
                                                   f"({condition} conditions, {gyros} gyros x {reps} reps)")
         save_figure(fig, out / "errors.png")
         files.append(out / "errors.png")

@@ -1,4 +1,4 @@
-"""Seed 000 Fig. 4: mean squared error of every parameter against servo speed.
+"""The servo method of Wang et al., Fig. 4: mean squared error of every parameter against servo speed.
 
 Speeds 0.3 to 3 rad/s in steps of 0.1, both noise levels, ``gyros x reps``
 calibrations per point (paper: 30 x 500 = 15,000), all by the fast path and batch
@@ -18,7 +18,7 @@ from ._common import METHOD_LABELS, PARAM_NAMES, Progress, ServoSettings, StudyO
 from ._crb import crb_std
 from ._tables import write_table
 
-#: Seed 000 section III-B: 0.3 to 3 rad/s in steps of 0.1 (28 speeds).
+#: The servo method of Wang et al., section III-B: 0.3 to 3 rad/s in steps of 0.1 (28 speeds).
 PAPER_SPEEDS = tuple(np.round(np.arange(0.3, 3.0 + 1e-9, 0.1), 10))
 
 
@@ -60,7 +60,7 @@ def run(
             obs = simulate_observations(k, b, speed=speed, sample_rate=settings.sample_rate, noise_std=noise,
                                         jitter=settings.jitter, misalignment=settings.misalignment, rng=rng)
             for m in methods:
-                mse[noise, m][i] = np.mean(fit_errors(m, obs, k, b) ** 2, axis=0)  # seed 000, eq. 9
+                mse[noise, m][i] = np.mean(fit_errors(m, obs, k, b) ** 2, axis=0)  # the servo method of Wang et al., eq. 9
             crb[noise][i] = np.mean(crb_std(k_g, b_g, speed=speed, noise_std=noise,
                                             sample_rate=settings.sample_rate) ** 2, axis=0)
             if progress:
@@ -72,10 +72,10 @@ def run(
             for (noise, m) in mse for i, s in enumerate(speeds)]
     files = list(write_table(out / "mse", header, rows))
     if plot:
-        from ..plotting._mpl import save_figure
+        from ..plotting import save_figure
         from ..plotting.studies import mse_speed_figure
 
-        fig = mse_speed_figure(speeds, mse, crb, title=f"seed 000 Fig. 4 ({gyros} gyros x {reps} reps per point)")
+        fig = mse_speed_figure(speeds, mse, crb, title=f"the servo method of Wang et al., Fig. 4 ({gyros} gyros x {reps} reps per point)")
         save_figure(fig, out / "mse.png")
         files.append(out / "mse.png")
     lines = []

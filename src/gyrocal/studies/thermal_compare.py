@@ -1,7 +1,7 @@
-"""Seed 001 Tables 3-4 analogue: traditional single-temperature calibration against the
-temperature table (3-node Lagrange, seed 001 eq. 21-22) and the smooth polynomial model.
+"""The full-temperature-range method, Tables 3-4 analogue: traditional single-temperature calibration against the
+temperature table (3-node Lagrange, the full-temperature-range method, eq. 21-22) and the smooth polynomial model.
 
-Each simulated gyro has seed 001's eq. 23 parameters at 25 degC, linear scale drift and
+Each simulated gyro has the full-temperature-range method's eq. 23 parameters at 25 degC, linear scale drift and
 a cubic bias drift (:class:`~gyrocal.simulation.thermal_truth.ThermalTruth`), with its
 drift coefficients scaled at random per gyro. It is calibrated on the Table 1
 temperatures with the Table 2 rates, then tested at temperatures between the nodes.
@@ -104,12 +104,12 @@ def run(
                          [[r["temp"], *[r[f"{m}_rms"] for m in METHODS]] for r in by_temp])
     floor = step_noise_floor(noise, sample_rate, step_duration)
     if plot:
-        from ..plotting._mpl import save_figure
+        from ..plotting import save_figure
         from ..plotting.studies import rms_by_temperature_figure
 
         fig = rms_by_temperature_figure([r["temp"] for r in by_temp],
                                         {m: [r[f"{m}_rms"] for r in by_temp] for m in METHODS}, floor=floor,
-                                        title=f"seed 001 Tables 3-4 analogue ({gyros} simulated gyros)")
+                                        title=f"the full-temperature-range method, Tables 3-4 analogue ({gyros} simulated gyros)")
         save_figure(fig, out / "thermal.png")
         files.append(out / "thermal.png")
     total = {m: float(np.sqrt(np.mean(merged.errors[m] ** 2)) * 180 / np.pi) for m in METHODS}

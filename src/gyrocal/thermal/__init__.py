@@ -1,4 +1,4 @@
-"""Full-temperature-range calibration (seed 001), end to end.
+"""Full-temperature-range calibration (the full-temperature-range method), end to end.
 
 Turntable recordings -> steps (:mod:`.session`) -> per-temperature 12-parameter
 least squares (:mod:`.fit`) -> a temperature table with 3-node Lagrange
@@ -11,8 +11,8 @@ from ._warn import DroppedStepsWarning, SaturatedStepsWarning, ThermalRangeWarni
 from .calibrate import calibrate_thermal, table_from_fit
 from .fit import PointFit, ThermalFit, fit_point, fit_session
 from .lagrange import interpolate, lagrange_weights
-from .model import ThermalCalibration, load_thermal, save_thermal
-from .session import Steps, find_steps, read_session, session_steps
+from .model import ThermalCalibration
+from .session import Steps, find_steps, session_steps
 from .smooth import SmoothModel, fit_smooth
 from .tempfilter import smooth_temperature
 
@@ -33,9 +33,6 @@ __all__ = [
     "fit_smooth",
     "interpolate",
     "lagrange_weights",
-    "load_thermal",
-    "read_session",
-    "save_thermal",
     "session_steps",
     "smooth_temperature",
     "table_from_fit",

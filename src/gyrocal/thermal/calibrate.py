@@ -32,7 +32,7 @@ def calibrate_thermal(recordings: Sequence[Recording], *, input_units: str | Non
                       temp_tolerance: float = 2.0, reference_temp: float = 25.0, max_order: int = 3,
                       temp_tau: float = DEFAULT_TEMP_TAU, names: Sequence[str] | None = None,
                       ) -> tuple[ThermalCalibration, ThermalFit]:
-    """Calibrate a gyro over temperature from turntable recordings (seed 001, whole method).
+    """Calibrate a gyro over temperature from turntable recordings (the full-temperature-range method, whole method).
 
     Parameters
     ----------

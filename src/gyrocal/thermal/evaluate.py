@@ -1,4 +1,4 @@
-"""Evaluation against a reference, like seed 001's Tables 3-4 and Figures 7-9.
+"""Evaluation against a reference, like the full-temperature-range method's Tables 3-4 and Figures 7-9.
 
 Each step of a test recording (constant table rate, position and temperature) is
 reduced to its mean; each compensation turns that mean into a rate estimate, whose

@@ -1,4 +1,4 @@
-"""Per-temperature 12-parameter least squares (seed 001, eq. 13-19).
+"""Per-temperature 12-parameter least squares (the full-temperature-range method, eq. 13-19).
 
 Eq. 13 stacks ``w = Kg Omega`` for every step. Because each gyro axis has its own
 four unknowns (one row of K and one bias), the 12-parameter problem splits exactly
@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import DegenerateDesignError
-from ..models import _KG_COLS, _KG_ROWS
+from ..models import kb_to_kg
 from .session import Steps
 
 __all__ = ["PointFit", "ThermalFit", "fit_point", "fit_session", "kg_eq19", "kg_from_beta", "omega_matrix"]
@@ -40,7 +40,7 @@ def kg_eq19(reference: np.ndarray, means: np.ndarray) -> np.ndarray:
 
 def kg_from_beta(beta: np.ndarray) -> np.ndarray:
     """Kg (..., 12) from per-axis solutions ``beta`` (..., 4, 3): ``beta[c, j] = K[j, c]``, ``beta[3, j] = B[j]``."""
-    return np.concatenate([beta[..., _KG_COLS, _KG_ROWS], beta[..., 3, :]], axis=-1)
+    return kb_to_kg(np.swapaxes(beta[..., :3, :], -1, -2), beta[..., 3, :])
 
 
 @dataclass(frozen=True)
@@ -86,7 +86,7 @@ def fit_point(reference, means, noise_var, count) -> PointFit:
         raise DegenerateDesignError(f"{len(ref)} steps cannot determine K and B at this temperature; each of x, y, z "
                                     "needs a non-zero table rate along it")
     inv = np.linalg.inv(XtX)
-    beta = inv @ (X.T @ np.asarray(means, float))  # (4, 3), seed 001 eq. 19 per axis
+    beta = inv @ (X.T @ np.asarray(means, float))  # (4, 3), the full-temperature-range method, eq. 19 per axis
     resid = means - X @ beta
     dof = max(len(ref) - 4, 1)
     s2 = (resid ** 2).sum(axis=0) / dof  # (3,)

@@ -1,4 +1,4 @@
-"""Three-node Lagrange interpolation in temperature (seed 001, eq. 21-22).
+"""Three-node Lagrange interpolation in temperature (the full-temperature-range method, eq. 21-22).
 
 The stencil rule is fixed, because the firmware export implements the same in C:
 with nodes ``T_0 < ... < T_{n-1}`` and ``i`` the first node ``>= T``, the stencil
@@ -14,18 +14,17 @@ outside ``[T_0, T_{n-1}]`` the caller chooses what happens.
 from __future__ import annotations
 
 import warnings
-from typing import Literal
 
 import numpy as np
 
 from .._validation import finite_array
+from ..choices import OutOfRange, values
 from ..errors import InputError, OutOfRangeError
 from ._warn import ThermalRangeWarning
 
 __all__ = ["OutOfRange", "RANGE_MARGIN", "check_nodes", "interpolate", "lagrange_weights", "range_policy", "stencil"]
 
-OutOfRange = Literal["refuse", "clamp", "extrapolate"]
-_POLICIES = ("refuse", "clamp", "extrapolate")
+_POLICIES = values(OutOfRange)
 
 #: Readings this close to the end nodes [degC] count as at them (GYROCAL_THERMAL_MARGIN in C).
 RANGE_MARGIN = 0.5
@@ -43,7 +42,8 @@ def check_nodes(nodes) -> np.ndarray:
 
 def range_policy(nodes: np.ndarray, temp: np.ndarray, out_of_range: OutOfRange) -> np.ndarray:
     if out_of_range not in _POLICIES:
-        raise InputError(f"out_of_range={out_of_range!r} is not one of {', '.join(_POLICIES)}")
+        raise InputError(f"{{param}}={out_of_range!r} is not one of {', '.join(_POLICIES)}", param="out_of_range",
+                         value=out_of_range)
     lo, hi = nodes[0], nodes[-1]
     outside = (temp < lo - RANGE_MARGIN) | (temp > hi + RANGE_MARGIN)
     if not outside.any():
@@ -51,7 +51,8 @@ def range_policy(nodes: np.ndarray, temp: np.ndarray, out_of_range: OutOfRange) 
     worst = float(temp[outside][np.argmax(np.abs(temp[outside] - (lo + hi) / 2))])
     where = f"{int(outside.sum())} temperature reading(s) outside the calibrated range [{lo:g}, {hi:g}] degC, e.g. {worst:.2f} degC"
     if out_of_range == "refuse":
-        raise OutOfRangeError(f"{where}; pass out_of_range='clamp' or 'extrapolate' to accept them")
+        raise OutOfRangeError(where, param="out_of_range", value=out_of_range,
+                              hint="set {param} to 'clamp' or 'extrapolate' to accept them")
     warnings.warn(f"{where}; {'clamped to the nearest end' if out_of_range == 'clamp' else 'extrapolated'}",
                   ThermalRangeWarning, stacklevel=3)
     return np.clip(temp, lo, hi) if out_of_range == "clamp" else temp
@@ -80,7 +81,7 @@ def lagrange_weights(nodes, temp, out_of_range: OutOfRange = "refuse") -> tuple[
     index : ndarray of int, shape (N, 3)
         Node indices ``s, s+1, s+2``.
     weight : ndarray, shape (N, 3)
-        Lagrange basis values at `temp` (seed 001, eq. 22); they sum to 1.
+        Lagrange basis values at `temp` (the full-temperature-range method, eq. 22); they sum to 1.
     """
     t = check_nodes(nodes)
     x = range_policy(t, finite_array("temp", temp, ndim=1), out_of_range)
@@ -88,14 +89,14 @@ def lagrange_weights(nodes, temp, out_of_range: OutOfRange = "refuse") -> tuple[
     idx = s[:, None] + np.arange(3)
     tn = t[idx]
     w = np.empty_like(tn)
-    for j in range(3):  # seed 001, eq. 22
+    for j in range(3):  # the full-temperature-range method, eq. 22
         a, b = tn[:, (j + 1) % 3], tn[:, (j + 2) % 3]
         w[:, j] = (x - a) * (x - b) / ((tn[:, j] - a) * (tn[:, j] - b))
     return idx, w
 
 
 def interpolate(nodes, values, temp, out_of_range: OutOfRange = "refuse") -> np.ndarray:
-    """Interpolate node values (n, ...) at temperatures (N,) [degC]; returns (N, ...) (seed 001, eq. 21)."""
+    """Interpolate node values (n, ...) at temperatures (N,) [degC]; returns (N, ...) (the full-temperature-range method, eq. 21)."""
     v = np.asarray(values, dtype=float)
     idx, w = lagrange_weights(nodes, np.atleast_1d(np.asarray(temp, dtype=float)), out_of_range)
     if v.shape[0] != len(np.asarray(nodes)):

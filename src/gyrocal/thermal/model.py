@@ -1,67 +1,63 @@
-"""The temperature table: per-point Kg, its interpolation, compensation and file.
+"""The temperature table: per-point Kg, its interpolation, compensation and document.
 
-File layout (``format: gyrocal.thermal``, ``version: 1``)::
+Document layout (``format: gyrocal.thermal``, ``version: 2``; see docs/files.md)::
 
     {
-      "format": "gyrocal.thermal", "version": 1, "model": "affine-thermal",
+      "format": "gyrocal.thermal", "version": 2, "model": "affine-thermal",
       "units": {"input": "deg/s", "output": "deg/s", "internal": "rad/s", "temperature": "degC"},
       "range": [Tmin, Tmax],
       "interpolation": {"rule": "...", "out_of_range": "refuse"},
       "reference_temp": 25.0,      # traditional baseline: the point nearest to it
       "temp_tau_s": 20.0,          # smoothing of per-sample temperature before lookup
-      "kg_names": ["Kxx", ..., "Bz"],
+      "kg_order": ["Kxx", ..., "Bz"],
       "points": [{"temp": ..., "kg": [...], "kg_user": [...], "std": [...], "std_noise": [...],
                   "residual_rms": [...], "correction": {"matrix": [[...]], "offset": [...]}}, ...],
       "smooth": {"centre": ..., "scale": ..., "orders": [...], "coefs": [[...]], ...},
-      "settings": {...}, "created_by": "gyrocal 0.1.0"
+      "fit": {...} | null,
+      "settings": {...}, "created_by": "gyrocal 0.2.0"
     }
 
-``kg`` is internal (K dimensionless, B in rad/s, eq. 14 order); ``kg_user`` has B in
-input units and K scaled by output/input unit factors, so ``w_in = K_user w_out + B_user``;
-``correction`` is the canonical ``w_out = matrix @ (raw - offset)`` in user units.
-The smooth model is stored for internal ``kg``.
+``kg`` is internal (K dimensionless, B in rad/s, the full-temperature-range method's eq. 14
+order); ``kg_user`` has B in input units and K scaled by output/input unit factors, so
+``w_in = K_user w_out + B_user``; ``correction`` is the canonical
+``w_out = matrix @ (raw - offset)`` in user units. The smooth model is stored for internal
+``kg``. Version 1 files are upgraded on load by :mod:`gyrocal.legacy`.
 """
 
 from __future__ import annotations
 
 import math
-import os
-from dataclasses import dataclass, field
-from typing import Literal
+from dataclasses import dataclass, field, replace
+from typing import Any, ClassVar
 
 import numpy as np
 
-from .. import __version__
-from .._jsonfile import check_header, get, get_array, read_json, write_json
-from .._validation import finite_array
+from .._arrays import readonly
+from .._jsonfile import check_header, get, get_array
+from .._validation import finite_array, refuse_options
+from .._version import __version__
+from ..choices import OutOfRange, TableModel, values
 from ..errors import FileFormatError, InputError, UnitError
-from ..models import _KG_COLS, _KG_ROWS, KG_NAMES, _freeze
+from ..files import register
+from ..models import KG_NAMES, kg_to_kb
+from ..sections import FitQuality, section
 from ..recording import Recording
 from ..units import RateUnit, parse_rate_unit, unit_factor
-from .lagrange import OutOfRange, check_nodes, interpolate, range_policy
+from .lagrange import check_nodes, interpolate, range_policy
 from .smooth import SmoothModel
 from .tempfilter import DEFAULT_TEMP_TAU, smooth_temperature
 
-__all__ = ["FORMAT", "VERSION", "TableModel", "ThermalCalibration", "kg_to_kb", "load_thermal", "save_thermal"]
+__all__ = ["RULE", "TableModel", "ThermalCalibration"]
 
-FORMAT = "gyrocal.thermal"
-VERSION = 1
-TableModel = Literal["lagrange", "smooth", "traditional"]
-_MODELS = ("lagrange", "smooth", "traditional")
-RULE = ("3-node Lagrange (seed 001 eq. 21-22): i = first node >= T, stencil nodes s..s+2 with s = clip(i-2, 0, n-3)")
+_MODELS = values(TableModel)
+RULE = ("3-node Lagrange (the full-temperature-range method, eq. 21-22): i = first node >= T, stencil nodes s..s+2 "
+        "with s = clip(i-2, 0, n-3)")
 
 
-def kg_to_kb(kg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """K (..., 3, 3) and B (..., 3) from Kg vectors (..., 12) (eq. 11 and 14)."""
-    kg = np.asarray(kg, float)
-    K = np.zeros(kg.shape[:-1] + (3, 3))
-    K[..., _KG_ROWS, _KG_COLS] = kg[..., :9]
-    return K, kg[..., 9:].copy()
-
-
+@register
 @dataclass(frozen=True)
 class ThermalCalibration:
-    """A gyro calibrated at several temperatures (seed 001).
+    """A gyro calibrated at several temperatures (the full-temperature-range method).
 
     Parameters
     ----------
@@ -84,7 +80,14 @@ class ThermalCalibration:
         Time constant of the temperature smoothing applied in :meth:`apply` [s].
     settings : dict
         How the table was made (settling time, tolerances), for the record.
+    fit : FitQuality or mapping, optional
+        How well the per-temperature fits hold together (the ``fit`` section).
     """
+
+    FORMAT: ClassVar[str] = "gyrocal.thermal"
+    VERSION: ClassVar[int] = 2
+    #: Options :meth:`apply` accepts.
+    APPLY_OPTIONS: ClassVar[tuple[str, ...]] = ("model", "out_of_range", "temp_tau")
 
     temps: np.ndarray
     kg: np.ndarray
@@ -97,12 +100,14 @@ class ThermalCalibration:
     residual_rms: np.ndarray | None = None
     temp_tau: float = DEFAULT_TEMP_TAU
     settings: dict = field(default_factory=dict)
+    fit: FitQuality | None = None
 
     def __post_init__(self):
         temps = check_nodes(self.temps)
         n = len(temps)
-        object.__setattr__(self, "temps", _freeze(temps))
-        object.__setattr__(self, "kg", _freeze(finite_array("kg", self.kg, shape_tail=(12,), ndim=2)))
+        object.__setattr__(self, "temps", readonly(temps, copy=True))
+        object.__setattr__(self, "kg", readonly(finite_array("kg", self.kg, shape_tail=(12,), ndim=2), copy=True))
+        object.__setattr__(self, "fit", section(FitQuality, self.fit))
         if self.kg.shape[0] != n:
             raise InputError(f"kg has {self.kg.shape[0]} rows but there are {n} temperature points")
         for name, width in (("std", 12), ("std_noise", 12), ("residual_rms", 3)):
@@ -111,7 +116,7 @@ class ThermalCalibration:
                 arr = finite_array(name, value, ndim=2)
                 if arr.shape != (n, width):
                     raise InputError(f"{name} must have shape ({n}, {width}), got {arr.shape}")
-                object.__setattr__(self, name, _freeze(arr))
+                object.__setattr__(self, name, readonly(arr, copy=True))
         object.__setattr__(self, "input_units", parse_rate_unit(self.input_units, "input_units"))
         object.__setattr__(self, "output_units", parse_rate_unit(self.output_units, "output_units"))
         if not math.isfinite(self.reference_temp):
@@ -160,7 +165,7 @@ class ThermalCalibration:
             return interpolate(self.temps, self.kg, t, out_of_range)
         if model == "smooth":
             return self.smooth(range_policy(self.temps, t, out_of_range))  # same range policy as the table
-        raise InputError(f"model={model!r} is not one of {', '.join(_MODELS)}")
+        raise InputError(f"{{param}}={model!r} is not one of {', '.join(_MODELS)}", param="model", value=model)
 
     def compensate(self, gyro, temp, model: TableModel = "lagrange", out_of_range: OutOfRange = "refuse") -> np.ndarray:
         """True rates (N, 3) [rad/s] from readings (N, 3) [rad/s] at temperatures (N,) [degC] (eq. 12 inverted)."""
@@ -169,95 +174,114 @@ class ThermalCalibration:
         K, B = kg_to_kb(self.kg_at(t, model, out_of_range))
         return np.linalg.solve(K, (w - B)[..., None])[..., 0]
 
-    def apply(self, rec: Recording, model: TableModel = "lagrange", out_of_range: OutOfRange = "refuse",
-              temp_tau: float | None = None) -> np.ndarray:
-        """Corrected rates (N, 3) [output units] of a recording with a per-sample ``temp``.
+    def apply(self, rec: Recording, **options) -> Recording:
+        """The recording with its gyro compensated in temperature.
 
         The temperature is first smoothed in time (:func:`smooth_temperature`, time
         constant `temp_tau`, default :attr:`temp_tau`), so quantised or noisy readings
         do not make the output jump.
+
+        Parameters
+        ----------
+        rec : Recording
+            Rates [rad/s] with a per-sample ``temp`` [degC].
+        **options
+            ``model`` ({"lagrange", "smooth", "traditional"}, default "lagrange"),
+            ``out_of_range`` ({"refuse", "clamp", "extrapolate"}, default "refuse"),
+            ``temp_tau`` [s] (default :attr:`temp_tau`).
+
+        Returns
+        -------
+        Recording
+            ``gyro`` compensated [rad/s], ``source_units`` the table's output unit.
         """
+        refuse_options(options, self.APPLY_OPTIONS, f"a {self.FORMAT} file")
+        if not isinstance(rec, Recording):
+            raise InputError(f"apply takes a Recording, got {type(rec).__name__}; use compensate(gyro, temp) for arrays")
         if rec.temp is None:
             raise InputError("thermal compensation needs a temperature for every sample; the recording has no "
-                             "'temp' column (map one with --columns temp=NAME)")
+                             "'temp' column", param="columns", hint="map one with {param} temp=NAME")
         if rec.units != "rad/s":
-            raise UnitError("the recording is in raw counts without a sensitivity; give its sensitivity in LSB per unit")
-        tau = self.temp_tau if temp_tau is None else temp_tau
-        temp = smooth_temperature(rec.temp, rec.sample_rate, tau)
-        return self.compensate(rec.gyro, temp, model, out_of_range) / unit_factor(self.output_units)
+            raise UnitError("the recording is in raw counts without a sensitivity", param="sensitivity",
+                            hint="give its {param} in LSB per unit")
+        tau = options.get("temp_tau")
+        temp = smooth_temperature(rec.temp, rec.sample_rate, self.temp_tau if tau is None else tau)
+        gyro = self.compensate(rec.gyro, temp, options.get("model", "lagrange"), options.get("out_of_range", "refuse"))
+        return replace(rec, gyro=gyro, source_units=self.output_units, sensitivity=None)
+
+    def c_header(self, prefix: str = "gyrocal") -> str:
+        """Firmware header for ``gyrocal_thermal_correct`` (see :func:`gyrocal.firmware.header.thermal_header`)."""
+        from ..firmware.header import thermal_header
+
+        return thermal_header(self, prefix=prefix)
+
+    # --- document ---------------------------------------------------------
+    def to_document(self) -> dict[str, Any]:
+        """The JSON-ready document (format version 2)."""
+        matrix, offset = self.correction
+        user = self.kg_user
+
+        def row(arr, i):
+            return None if arr is None else arr[i].tolist()
+
+        points = [{"temp": float(t), "kg": self.kg[i].tolist(), "kg_user": user[i].tolist(),
+                   "std": row(self.std, i), "std_noise": row(self.std_noise, i),
+                   "residual_rms": row(self.residual_rms, i),
+                   "correction": {"matrix": matrix[i].tolist(), "offset": offset[i].tolist()}}
+                  for i, t in enumerate(self.temps)]
+        return {
+            "format": self.FORMAT, "version": self.VERSION, "model": "affine-thermal",
+            "units": {"input": self.input_units, "output": self.output_units, "internal": "rad/s",
+                      "temperature": "degC"},
+            "range": list(self.range),
+            "interpolation": {"rule": RULE, "out_of_range": "refuse"},
+            "reference_temp": self.reference_temp,
+            "temp_tau_s": self.temp_tau,
+            "kg_order": list(KG_NAMES),
+            "points": points,
+            "smooth": self.smooth.to_dict(),
+            "fit": None if self.fit is None else self.fit.to_document(),
+            "settings": self.settings,
+            "created_by": f"gyrocal {__version__}",
+        }
+
+    @classmethod
+    def from_document(cls, doc: dict, path: Any = "document") -> ThermalCalibration:
+        """Validate a version-2 document and rebuild the table, naming any bad field."""
+        if not isinstance(doc, dict):
+            raise FileFormatError(f"{path}: expected a JSON object at the top level, got {type(doc).__name__}")
+        check_header(doc, path, cls.FORMAT, (cls.VERSION,))
+        if get(doc, "kg_order", path) != list(KG_NAMES):
+            raise FileFormatError(f"{path}: field 'kg_order' must be {list(KG_NAMES)}", "kg_order")
+        pts = get(doc, "points", path)
+        if not isinstance(pts, list) or len(pts) < 3:
+            raise FileFormatError(f"{path}: field 'points' must list at least 3 temperature points", "points")
+        named = {f"points[{i}]": p for i, p in enumerate(pts)}  # so messages say points[2].kg
+        cols = {}
+        for key, width in (("temp", 1), ("kg", 12), ("std", 12), ("std_noise", 12), ("residual_rms", 3)):
+            rows = [get_array(named, f"{name}.{key}", (width,) if key != "temp" else (), path,
+                              allow_none=key not in ("kg", "temp")) for name in named]
+            cols[key] = None if any(r is None for r in rows) else np.stack(rows)
+        fit = doc.get("fit")
+        try:
+            return cls(
+                temps=cols["temp"], kg=cols["kg"], smooth=_smooth_from_document(doc, path),
+                input_units=get(doc, "units.input", path), output_units=get(doc, "units.output", path),
+                reference_temp=float(get(doc, "reference_temp", path)), std=cols["std"],
+                std_noise=cols["std_noise"], residual_rms=cols["residual_rms"],
+                temp_tau=float(doc.get("temp_tau_s", DEFAULT_TEMP_TAU)), settings=dict(doc.get("settings") or {}),
+                fit=None if fit is None else FitQuality.from_document(fit, path))
+        except (InputError, TypeError, ValueError) as exc:
+            if isinstance(exc, FileFormatError):
+                raise
+            raise FileFormatError(f"{path}: {exc}") from None
 
 
-# --- file -------------------------------------------------------------------
-def _opt_list(a):
-    return None if a is None else a.tolist()
-
-
-def to_document(cal: ThermalCalibration) -> dict:
-    """The JSON-ready document of a thermal calibration."""
-    matrix, offset = cal.correction
-    user = cal.kg_user
-    points = []
-    for i, t in enumerate(cal.temps):
-        points.append({
-            "temp": float(t), "kg": cal.kg[i].tolist(), "kg_user": user[i].tolist(),
-            "std": None if cal.std is None else cal.std[i].tolist(),
-            "std_noise": None if cal.std_noise is None else cal.std_noise[i].tolist(),
-            "residual_rms": None if cal.residual_rms is None else cal.residual_rms[i].tolist(),
-            "correction": {"matrix": matrix[i].tolist(), "offset": offset[i].tolist()},
-        })
-    return {
-        "format": FORMAT, "version": VERSION, "model": "affine-thermal",
-        "units": {"input": cal.input_units, "output": cal.output_units, "internal": "rad/s", "temperature": "degC"},
-        "range": list(cal.range),
-        "interpolation": {"rule": RULE, "out_of_range": "refuse"},
-        "reference_temp": cal.reference_temp,
-        "temp_tau_s": cal.temp_tau,
-        "kg_names": list(KG_NAMES),
-        "points": points,
-        "smooth": cal.smooth.to_dict(),
-        "settings": cal.settings,
-        "created_by": f"gyrocal {__version__}",
-    }
-
-
-def save_thermal(cal: ThermalCalibration, path: str | os.PathLike) -> None:
-    """Write `cal` as versioned JSON, atomically."""
-    write_json(path, to_document(cal))
-
-
-def from_document(doc: dict, path="file") -> ThermalCalibration:
-    """Validate a document and rebuild the calibration, naming any bad field."""
-    check_header(doc, path, FORMAT, (VERSION,))
-    if list(get(doc, "kg_names", path)) != list(KG_NAMES):
-        raise FileFormatError(f"{path}: field 'kg_names' must be {list(KG_NAMES)}", "kg_names")
-    pts = get(doc, "points", path)
-    if not isinstance(pts, list) or len(pts) < 3:
-        raise FileFormatError(f"{path}: field 'points' must list at least 3 temperature points", "points")
-    named = {f"points[{i}]": p for i, p in enumerate(pts)}  # so messages say points[2].kg
-    cols = {}
-    for key, width in (("temp", 1), ("kg", 12), ("std", 12), ("std_noise", 12), ("residual_rms", 3)):
-        rows = [get_array(named, f"{name}.{key}", (width,) if key != "temp" else (), path,
-                          allow_none=key not in ("kg", "temp")) for name in named]
-        cols[key] = None if any(r is None for r in rows) else np.stack(rows)
-    temps = cols.pop("temp")
+def _smooth_from_document(doc: dict, path) -> SmoothModel:
     raw = get(doc, "smooth.coefs", path)
     width = len(raw[0]) if isinstance(raw, list) and raw and isinstance(raw[0], list) else 0
     coefs = get_array(doc, "smooth.coefs", (12, width), path)
     loto = get(doc, "smooth", path).get("loto_rms") or np.zeros((1, 12))
-    try:
-        smooth = SmoothModel(centre=float(get(doc, "smooth.centre", path)), scale=float(get(doc, "smooth.scale", path)),
-                             orders=np.asarray(get(doc, "smooth.orders", path), int), coefs=coefs,
-                             loto_rms=np.asarray(loto, float))
-        return ThermalCalibration(
-            temps=temps, kg=cols["kg"], smooth=smooth,
-            input_units=get(doc, "units.input", path), output_units=get(doc, "units.output", path),
-            reference_temp=float(get(doc, "reference_temp", path)), std=cols["std"], std_noise=cols["std_noise"],
-            residual_rms=cols["residual_rms"], temp_tau=float(doc.get("temp_tau_s", DEFAULT_TEMP_TAU)),
-            settings=dict(doc.get("settings") or {}))
-    except (InputError, TypeError, ValueError) as exc:
-        raise FileFormatError(f"{path}: {exc}") from None
-
-
-def load_thermal(path: str | os.PathLike) -> ThermalCalibration:
-    """Read and validate a ``gyrocal.thermal`` file."""
-    return from_document(read_json(path), path)
+    return SmoothModel(centre=float(get(doc, "smooth.centre", path)), scale=float(get(doc, "smooth.scale", path)),
+                       orders=np.asarray(get(doc, "smooth.orders", path), int), coefs=coefs,
+                       loto_rms=np.asarray(loto, float))

@@ -71,8 +71,8 @@ def write_report(cal: ThermalCalibration, evaluation: Evaluation, out_dir: str |
         f"{cal.temps[cal.reference_index]:g} degC (nearest {cal.reference_temp:g} degC). Test: "
         f"{len(evaluation.steps)} steps at {np.min(evaluation.steps.temp):.1f} to {np.max(evaluation.steps.temp):.1f} "
         f"degC. Errors are step means minus the table rate, in {unit}.\n"),
-        "## RMS error (seed 001 Table 4)\n", markdown_table(summary, rms_cols),
-        "\n## Mean error (seed 001 Table 3)\n", markdown_table(summary, mean_cols),
+        "## RMS error (the full-temperature-range method, Table 4)\n", markdown_table(summary, rms_cols),
+        "\n## Mean error (the full-temperature-range method, Table 3)\n", markdown_table(summary, mean_cols),
     ]
     if loto:
         text += ["\n## Lagrange against smooth: leave-one-temperature-out error (internal units: K, rad/s)\n",
@@ -85,7 +85,7 @@ def write_report(cal: ThermalCalibration, evaluation: Evaluation, out_dir: str |
 
 
 def _figures(cal, evaluation, out: Path, unit: str, truth) -> list[Path]:
-    from ..plotting._mpl import save_figure
+    from ..plotting import save_figure
     from ..plotting.thermal import plot_coefficients, plot_error_vs_rate, plot_error_vs_temperature
 
     paths = []

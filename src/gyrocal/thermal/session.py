@@ -3,31 +3,28 @@
 A step is a run of samples with one commanded table rate, one body axis along the
 table, and no time gap. Its first ``settle`` seconds (the table's and the sensor's
 transient) are dropped and the rest is reduced to a mean, which is one observation
-of seed 001's eq. 13. Consecutive steps within ``temp_tolerance`` of each other
+of the full-temperature-range method's eq. 13. Consecutive steps within ``temp_tolerance`` of each other
 form a temperature block; a session needs one block per temperature point.
 """
 
 from __future__ import annotations
 
-import os
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, fields
-from pathlib import Path
 
 import numpy as np
 
 from .._validation import positive
 from ..errors import InputError
-from ..io.saturation import find_saturation
+from ..saturation import find_saturation
 from ..recording import Recording
 from ._warn import DroppedStepsWarning, SaturatedStepsWarning
 
-__all__ = ["AXES", "Steps", "drop_saturated", "drop_unstable", "find_steps", "read_session", "session_steps"]
+__all__ = ["AXES", "Steps", "drop_saturated", "drop_unstable", "find_steps", "session_steps"]
 
 AXES = ("x", "y", "z")
 _SPAN_CHUNKS = 8  # a step's temperature stability is judged on the means of this many chunks
-_SESSION_SUFFIXES = (".csv", ".txt", ".parquet", ".pq", ".bag", ".mcap", ".db3")
 
 
 @dataclass(frozen=True)
@@ -280,29 +277,3 @@ def session_steps(recordings: Sequence[Recording], *, settle: float = 2.0, full_
                              f"points have: {_describe_keys(missing)}")
     steps = drop_saturated(steps)
     return steps
-
-
-def read_session(path: str | os.PathLike, *, units: str, **read_options) -> tuple[list[Recording], list[str]]:
-    """Read a session: one file, or a folder with one file per temperature point.
-
-    Parameters
-    ----------
-    path : path
-        A recording file or a folder of them (``.csv``, ``.parquet``, bags; sorted by name).
-    units : str
-        Unit of the readings and of ``table_rate`` (``deg/s``, ``rad/s``, ``counts``).
-    **read_options
-        Passed to :func:`gyrocal.io.read_recording` (``columns``, ``sensitivity``, ...).
-    """
-    from ..io import read_recording
-
-    p = Path(path)
-    if p.is_dir():
-        files = sorted(f for f in p.iterdir() if f.is_file() and f.suffix.lower() in _SESSION_SUFFIXES)
-        if not files:
-            raise InputError(f"{p}: the folder holds no recordings ({', '.join(_SESSION_SUFFIXES)})")
-    elif p.exists():
-        files = [p]
-    else:
-        raise InputError(f"{p}: no such file or folder")
-    return [read_recording(f, units=units, **read_options) for f in files], [f.name for f in files]

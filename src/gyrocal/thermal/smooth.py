@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._arrays import readonly
 from .._validation import finite_array
 from ..errors import InputError
 
@@ -76,9 +77,8 @@ class SmoothModel:
             raise InputError(f"orders must be {coefs.shape[0]} values in 0..{coefs.shape[1] - 1}, got {orders.tolist()}")
         if not self.scale > 0:
             raise InputError(f"scale must be > 0 degC, got {self.scale!r}")
-        for name, arr in (("coefs", coefs), ("orders", orders), ("loto_rms", np.asarray(self.loto_rms, float))):
-            arr.setflags(write=False)
-            object.__setattr__(self, name, arr)
+        for name, arr in (("coefs", coefs), ("orders", orders), ("loto_rms", self.loto_rms)):
+            object.__setattr__(self, name, readonly(arr, None if name == "orders" else float, copy=True))
 
     def __call__(self, temp) -> np.ndarray:
         """Values (N, m) at temperatures (N,) [degC]."""

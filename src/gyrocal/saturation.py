@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validation import positive
-from ..errors import InputError
+from ._validation import positive
+from .errors import InputError
 
 __all__ = ["find_saturation", "MIN_RUN"]
 

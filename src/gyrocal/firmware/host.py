@@ -1,13 +1,9 @@
-"""Firmware support: C headers for the shipped C library, and a ctypes loader for it.
+"""The C library on the host: build it with the host's C compiler and call it through ctypes.
 
-The C library in ``gyrocal/c/`` (``gyrocal_cal.h``, ``gyrocal_cal.c``) corrects readings,
-applies a thermal table and runs the six-observation calibration on a microcontroller.
-This module
-
-* writes calibrations as C headers that the library reads directly
-  (:func:`c_header`, :func:`thermal_c_header`);
-* compiles the library with the host's C compiler into a cache folder and loads it
-  with ctypes (:func:`load_library`), so tests and tools can check it against Python.
+:func:`load_library` compiles ``gyrocal/c/gyrocal_cal.c`` (plus any driver sources) into a
+cache folder, once per content, and returns a :class:`CLibrary` whose methods call the C
+functions one sample at a time, as a device would, so tests and tools can check the C
+library against Python.
 """
 
 from __future__ import annotations
@@ -24,11 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__
-from ._atomic import atomic_path
-from ._validation import finite_array, positive
-from .calibration import Calibration
-from .errors import (
+from .._atomic import atomic_path
+from .._validation import finite_array, positive
+from ..errors import (
     ConvergenceError,
     DegenerateDesignError,
     GyrocalError,
@@ -37,12 +31,9 @@ from .errors import (
     NonPhysicalEstimateError,
     OutOfRangeError,
 )
-from .models import KG_NAMES, ScaleBias
 
-__all__ = [
-    "C_FLAGS", "CCompileError", "CLibrary", "build_library", "c_header", "c_source_dir", "find_c_compiler",
-    "load_library", "thermal_c_header",
-]
+__all__ = ["C_FLAGS", "STATUS", "CCompileError", "CLibrary", "build_library", "c_source_dir", "find_c_compiler",
+           "load_library"]
 
 #: Host flags: strict C99 and no fused multiply-add, so host results are plain float32 operations.
 C_FLAGS: tuple[str, ...] = ("-std=c99", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-Wall", "-Wextra")
@@ -54,151 +45,7 @@ class CCompileError(GyrocalError):
 
 def c_source_dir() -> Path:
     """Folder of the shipped C library (``gyrocal_cal.h``, ``gyrocal_cal.c``)."""
-    return Path(__file__).resolve().parent / "c"
-
-
-# -- headers ---------------------------------------------------------------------------------------------------
-
-
-def _c_float(x: float) -> str:
-    """A float32 C literal that reads back to the same float32 (9 significant digits)."""
-    v = float(np.float32(x))
-    if not np.isfinite(v):
-        raise InputError(f"cannot write {x!r} to a C header; every value must be finite in float32")
-    return f"{v:.9e}f"
-
-
-def _c_vector(values) -> str:
-    return "{" + ", ".join(_c_float(v) for v in np.ravel(values)) + "}"
-
-
-def _header(name: str, comment: list[str], input_units: str, output_units: str, body: str) -> str:
-    """A header ``GYROCAL_<NAME>_H``: comment block, guard, the library's types, unit macros, `body`."""
-    guard = f"GYROCAL_{name}_H"
-    return (
-        "/*\n" + "\n".join(f" * {line}".rstrip() for line in comment) + "\n */\n"
-        + f"#ifndef {guard}\n#define {guard}\n\n"
-        + '#include "gyrocal_cal.h"\n\n'
-        + f'#define GYROCAL_{name}_INPUT_UNITS "{input_units}"\n'
-        + f'#define GYROCAL_{name}_OUTPUT_UNITS "{output_units}"\n\n'
-        + body
-        + f"\n#endif /* {guard} */\n"
-    )
-
-
-def _param_lines(cal: Calibration) -> list[str]:
-    """The paper's parameters with their 1-sigma, one per comment line."""
-    model, std = cal.model, cal.std
-    paper = "seed 000 eq. 1, g = diag(k) (m + b)" if isinstance(model, ScaleBias) else "seed 001 eq. 12, w = K w~ + B"
-    lines = [f"Paper parameters ({paper}), internal units {cal.internal_units}, 1-sigma:"]
-    for i, (name, value) in enumerate(zip(model.param_names, model.params)):
-        sigma = "not estimated" if std is None else f"+- {std[i]:.3e}"
-        lines.append(f"  {name:>4} = {value: .9e}  {sigma}")
-    return lines
-
-
-def c_header(cal: Calibration) -> str:
-    """C header defining ``GYROCAL_CALIBRATION``, a ``gyrocal_affine_t`` for ``gyrocal_correct``.
-
-    The matrix and offset are in the user's units (:attr:`Calibration.correction`), so the
-    firmware feeds raw readings in ``cal.input_units`` and gets ``cal.output_units``. The
-    comment block states the convention, the units, the paper's parameters with their
-    1-sigma and where the numbers came from.
-
-    Parameters
-    ----------
-    cal : Calibration
-        A scale-bias or affine calibration.
-
-    Returns
-    -------
-    str
-        The header text (C99), to be written to a ``.h`` file.
-    """
-    if not isinstance(cal, Calibration):
-        raise InputError(f"cal must be a gyrocal.Calibration, got {type(cal).__name__}")
-    matrix, offset = cal.correction
-    sens = "" if cal.sensitivity is None else f" (sensitivity {cal.sensitivity:g} LSB per {cal.output_units})"
-    comment = [
-        f"gyrocal calibration, generated by gyrocal {__version__}; do not edit.",
-        "",
-        "Model: w_true = matrix @ (raw - offset)   (C: gyrocal_correct(&GYROCAL_CALIBRATION, raw, w_true))",
-        f"  raw and offset in {cal.input_units}{sens}; w_true in {cal.output_units}.",
-        "",
-        *_param_lines(cal),
-        "",
-        f"Provenance: model {cal.model.kind}, method {cal.method}, {len(cal.windows)} window(s)"
-        + ("" if cal.noise_std is None
-           else f", per-sample noise std {np.round(cal.noise_std, 6).tolist()} {cal.internal_units}")
-        + ".",
-    ]
-    rows = ",\n".join(f"        {_c_vector(row)}" for row in matrix)
-    body = (
-        "static const gyrocal_affine_t GYROCAL_CALIBRATION = {\n"
-        + f"    {{\n{rows}\n    }},\n"
-        + f"    {_c_vector(offset)}\n"
-        + "};\n"
-    )
-    return _header("CALIBRATION", comment, cal.input_units, cal.output_units, body)
-
-
-def thermal_c_header(tc) -> str:
-    """C header defining ``GYROCAL_THERMAL``, a ``gyrocal_thermal_t`` for ``gyrocal_thermal_correct``.
-
-    Parameters
-    ----------
-    tc : gyrocal.thermal.ThermalCalibration
-        Any object with ``temps`` (n,) [degC], ``kg_user`` (n, 12) in seed 001 eq. 14 order
-        (K maps output units to input units, B in input units), ``input_units`` and
-        ``output_units``; ``range`` (Tmin, Tmax) [degC] when present, else the end nodes.
-
-    Returns
-    -------
-    str
-        The header text (C99).
-    """
-    temps = finite_array("temps", getattr(tc, "temps", None), ndim=1)
-    kg = finite_array("kg_user", getattr(tc, "kg_user", None), shape_tail=(12,), ndim=2)
-    if len(temps) < 3 or kg.shape[0] != len(temps) or np.any(np.diff(temps) <= 0):
-        raise InputError(
-            f"a thermal table needs >= 3 strictly increasing temperatures and one Kg row each, "
-            f"got temps {np.round(temps, 3).tolist()} and kg_user of shape {kg.shape}"
-        )
-    n = len(temps)
-    lo, hi = getattr(tc, "range", (temps[0], temps[-1]))
-    comment = [
-        f"gyrocal thermal calibration, generated by gyrocal {__version__}; do not edit.",
-        "",
-        "Model (seed 001 eq. 12): raw = K(T) w + B(T), so w = K(T)^-1 (raw - B(T))",
-        "  (C: gyrocal_thermal_correct(&GYROCAL_THERMAL, temp_degC, raw, flags, w)).",
-        f"  raw and B in {tc.input_units}; w in {tc.output_units}; K in {tc.input_units} per {tc.output_units}.",
-        "Rows: Kg at each temperature node [degC], seed 001 eq. 14 order",
-        "  " + ", ".join(KG_NAMES) + ".",
-        "Interpolation (seed 001 eq. 21-22): 3-node Lagrange over nodes s, s+1, s+2 with",
-        "  s = clamp(i - 2, 0, n - 3), i the first node >= T (the same rule as gyrocal.thermal).",
-        f"More than GYROCAL_THERMAL_MARGIN outside [{lo:g}, {hi:g}] degC the call fails with GYROCAL_E_RANGE",
-        "  unless GYROCAL_THERMAL_CLAMP is passed; closer, the temperature is clamped to the range.",
-    ]
-    tau = getattr(tc, "temp_tau", None)
-    if tau:
-        comment += [
-            f"Temperature: gyrocal apply low-passes the temp readings (time constant {tau:g} s) before the lookup,",
-            "  so 1 degC steps do not make the output jump. apply filters forward and backward (no lag); a device",
-            "  can only filter forward, which lags by about that time constant:",
-            "  alpha = 1 - expf(-dt / GYROCAL_THERMAL_TEMP_TAU_S) once, state = first reading, then per sample",
-            "  temp_degC = gyrocal_temp_filter(&state, reading, alpha).",
-        ]
-    rows = ",\n".join(f"    {_c_vector(row)}" for row in kg)
-    body = (
-        f"#define GYROCAL_THERMAL_N {n}\n"
-        + (f"#define GYROCAL_THERMAL_TEMP_TAU_S {float(tau)!r}f\n" if tau else "")
-        + "\n"
-        + f"static const float GYROCAL_THERMAL_TEMPS[GYROCAL_THERMAL_N] = {_c_vector(temps)};\n\n"
-        + f"static const float GYROCAL_THERMAL_KG[GYROCAL_THERMAL_N][12] = {{\n{rows}\n}};\n\n"
-        + "static const gyrocal_thermal_t GYROCAL_THERMAL = {GYROCAL_THERMAL_N, GYROCAL_THERMAL_TEMPS, "
-        + "GYROCAL_THERMAL_KG};\n"
-    )
-    return _header("THERMAL", comment, tc.input_units, tc.output_units, body)
+    return Path(__file__).resolve().parent.parent / "c"
 
 
 # -- host build ------------------------------------------------------------------------------------------------
@@ -245,7 +92,7 @@ def build_library(
     if cc is None:
         raise MissingDependencyError("no C compiler found; install one (apt-get install gcc) or set CC")
     src = c_source_dir()
-    sources = [src / "gyrocal_cal.c", *map(Path, extra_sources)]
+    sources = [*sorted(src.glob("*.c")), *map(Path, extra_sources)]
     incs = [src, *map(Path, include_dirs)]
     digest = hashlib.sha256("\0".join([cc, *C_FLAGS]).encode())
     for path in sources + sorted(p for d in incs for p in Path(d).glob("*.h")):
@@ -302,7 +149,7 @@ _SIGNATURES = {
 }
 
 #: gyrocal_status_t codes (gyrocal_cal.h) and the Python error each one becomes.
-_STATUS = {1: ("GYROCAL_E_INPUT", InputError), 2: ("GYROCAL_E_SINGULAR", DegenerateDesignError),
+STATUS = {1: ("GYROCAL_E_INPUT", InputError), 2: ("GYROCAL_E_SINGULAR", DegenerateDesignError),
           3: ("GYROCAL_E_NONPHYSICAL", NonPhysicalEstimateError), 4: ("GYROCAL_E_NOCONV", ConvergenceError),
           5: ("GYROCAL_E_RANGE", OutOfRangeError)}
 
@@ -330,7 +177,7 @@ class CLibrary:
     def _check(self, status: int, what: str, iterations: int = 0) -> None:
         if status == 0:
             return
-        name, cls = _STATUS.get(status, (f"status {status}", GyrocalError))
+        name, cls = STATUS.get(status, (f"status {status}", GyrocalError))
         message = f"the C library's {what} returned {name}"
         if cls is ConvergenceError:
             raise cls(f"{message}: did not converge after {iterations} iterations", iterations)
@@ -388,7 +235,7 @@ class CLibrary:
         return np.array(out.k, np.float32), np.array(out.b, np.float32), it.value
 
     def algorithm1(self, mean_sq, mean, rate) -> tuple[np.ndarray, np.ndarray, int]:
-        """Seed 000 Algorithm 1 on six windows; ``(k, b, iterations)``."""
+        """The servo method of Wang et al., Algorithm 1 on six windows; ``(k, b, iterations)``."""
         return self._six("gyrocal_algorithm1", mean, mean_sq, rate)
 
     def first_moment(self, mean, rate) -> tuple[np.ndarray, np.ndarray, int]:

@@ -1,0 +1,29 @@
+/*
+ * board.h: the board layer of the gyrocal example firmware. A port (Arduino, STM32 HAL, Pico SDK, a
+ * host test) provides these four functions; everything else is portable C99.
+ */
+#ifndef GYROCAL_EXAMPLE_BOARD_H
+#define GYROCAL_EXAMPLE_BOARD_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Wait until the next sample is due, then read the gyro [counts] and its temperature [0.01 degC]
+ * (GYROCAL_TEMP_NONE without one). Returns 0, or non-zero when there are no more samples
+ * (a host test's simulated session ends; real boards never end). */
+int board_read_gyro(int16_t raw[3], int16_t *temp_centi);
+/* Send n bytes to the host (a UART, USB CDC); may block while the transmit buffer is full. */
+void board_write(const uint8_t *data, size_t n);
+/* Free-running clocks since power-up [us] and [ms], wrapping at 2^32. */
+uint32_t board_micros(void);
+uint32_t board_millis(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

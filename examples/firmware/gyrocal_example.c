@@ -1,0 +1,86 @@
+/*
+ * gyrocal_example.c: example firmware for `gyrocal capture` (part of gyrocal, MIT licence).
+ * See gyrocal_example.h; the board layer is board.h.
+ */
+#include "gyrocal_example.h"
+
+#include "board.h"
+
+static void send_text(example_t *ex, const char *a, const char *b)
+{
+    char text[GYROCAL_FRAME_MAX_PAYLOAD + 1];
+    size_t n = 0u;
+    while (*a && n < GYROCAL_FRAME_MAX_PAYLOAD) {
+        text[n++] = *a++;
+    }
+    while (*b && n < GYROCAL_FRAME_MAX_PAYLOAD) {
+        text[n++] = *b++;
+    }
+    text[n] = '\0';
+    board_write(ex->frame, gyrocal_frame_text(ex->frame, text));
+}
+
+void example_setup(example_t *ex, float sample_rate, float sensitivity, int has_temp)
+{
+    static const char name[] = EXAMPLE_FIRMWARE;
+    gyrocal_hello_t hello;
+    size_t i;
+    gyrocal_session_init(&ex->session, sample_rate, sensitivity, 360.0f);
+    ex->calibrated = 0;
+    ex->seq = 0u;
+    hello.sample_rate = sample_rate;
+    hello.sensitivity = sensitivity;
+    hello.rate_unit = GYROCAL_UNIT_DEG_S;
+    hello.flags = has_temp ? GYROCAL_HELLO_HAS_TEMP : 0u;
+    hello.library = 0x0100u;
+    for (i = 0; i < sizeof hello.firmware; ++i) {
+        hello.firmware[i] = i < sizeof name - 1u ? name[i] : '\0';
+    }
+    board_write(ex->frame, gyrocal_frame_hello(ex->frame, &hello));
+}
+
+static void report(example_t *ex, unsigned events)
+{
+    static const char *const labels[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
+    static const char *const reasons[4] = {" accepted", " ignored: wrong angle", " ignored: off axis",
+                                           " ignored: too long"};
+    gyrocal_session_t *s = &ex->session;
+    if (events & GYROCAL_SESSION_TURN) {
+        board_write(ex->frame, gyrocal_frame_turn(ex->frame, &s->turn));
+        send_text(ex, labels[s->turn.slot], reasons[s->turn.status < 4u ? s->turn.status : 1u]);
+    }
+    if (events & GYROCAL_SESSION_RESULT) {
+        board_write(ex->frame, gyrocal_frame_result(ex->frame, s->status, GYROCAL_METHOD_FIRST_MOMENT,
+                                                    (uint8_t)s->iterations, GYROCAL_N_OBS,
+                                                    s->status == GYROCAL_OK ? &s->result : 0, s->seq - 1u));
+        if (s->status == GYROCAL_OK) {
+            gyrocal_scale_bias_to_affine(&s->result, &ex->cal);
+            ex->calibrated = 1;
+        }
+    }
+}
+
+int example_step(example_t *ex)
+{
+    int16_t raw[3], temp = GYROCAL_TEMP_NONE;
+    uint32_t t_us;
+    unsigned events;
+    if (board_read_gyro(raw, &temp) != 0) {
+        return 1;
+    }
+    t_us = board_micros();
+    board_write(ex->frame, gyrocal_frame_sample(ex->frame, ex->seq, t_us, raw, temp));
+    events = gyrocal_session_add(&ex->session, raw);
+    if (events) {
+        report(ex, events);
+    }
+#if EXAMPLE_SEND_CALIBRATED
+    if (ex->calibrated) {
+        float x[3] = {(float)raw[0], (float)raw[1], (float)raw[2]}, w[3];
+        gyrocal_correct(&ex->cal, x, w);
+        board_write(ex->frame, gyrocal_frame_calibrated(ex->frame, ex->seq, t_us, w));
+    }
+#endif
+    ++ex->seq;
+    return 0;
+}

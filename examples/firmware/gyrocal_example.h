@@ -1,0 +1,45 @@
+/*
+ * gyrocal_example.h: example firmware for `gyrocal capture` (part of gyrocal, MIT licence).
+ *
+ * Streams every sample as a gyrocal frame, runs the six-turn calibration of the servo method of
+ * Wang et al. on the device (gyrocal_session), reports each turn and its result, and from then on
+ * also sends the corrected samples. Portable C99: the board layer (board.h) is the only port.
+ */
+#ifndef GYROCAL_EXAMPLE_H
+#define GYROCAL_EXAMPLE_H
+
+#include <stdint.h>
+
+#include "gyrocal_cal.h"
+#include "gyrocal_frame.h"
+#include "gyrocal_session.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#ifndef EXAMPLE_FIRMWARE
+#define EXAMPLE_FIRMWARE "gyrocal-example"
+#endif
+#ifndef EXAMPLE_SEND_CALIBRATED
+#define EXAMPLE_SEND_CALIBRATED 1 /* after calibrating, send corrected samples too (as in the paper) */
+#endif
+
+typedef struct {
+    gyrocal_session_t session;
+    gyrocal_affine_t cal; /* the device's correction once calibrated */
+    int calibrated;
+    uint32_t seq;
+    uint8_t frame[GYROCAL_FRAME_MAX];
+} example_t;
+
+/* Start: set up the session and send the hello frame. sample_rate [Hz], sensitivity [counts per deg/s]. */
+void example_setup(example_t *ex, float sample_rate, float sensitivity, int has_temp);
+/* One sample: read, send, calibrate. Returns 0, or non-zero when the board has no more samples. */
+int example_step(example_t *ex);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

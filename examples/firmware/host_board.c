@@ -1,0 +1,67 @@
+/*
+ * host_board.c: a fake board layer for host tests. It plays a recorded or simulated session given as
+ * arrays and collects everything the firmware sends in a buffer; example_run() drives the example
+ * firmware over the whole session. Built into a shared library by tests/test_capture_firmware.py.
+ */
+#include "board.h"
+#include "gyrocal_example.h"
+
+static const int16_t *g_raw, *g_temp;
+static const uint32_t *g_t_us;
+static uint32_t g_n, g_i;
+static uint8_t *g_out;
+static size_t g_cap, g_len, g_dropped;
+
+int board_read_gyro(int16_t raw[3], int16_t *temp_centi)
+{
+    if (g_i >= g_n) {
+        return 1;
+    }
+    raw[0] = g_raw[3 * g_i];
+    raw[1] = g_raw[3 * g_i + 1];
+    raw[2] = g_raw[3 * g_i + 2];
+    *temp_centi = g_temp ? g_temp[g_i] : GYROCAL_TEMP_NONE;
+    ++g_i;
+    return 0;
+}
+
+void board_write(const uint8_t *data, size_t n)
+{
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        if (g_len < g_cap) {
+            g_out[g_len++] = data[i];
+        } else {
+            ++g_dropped;
+        }
+    }
+}
+
+uint32_t board_micros(void)
+{
+    return g_t_us[g_i - 1u]; /* the stamp of the sample just read */
+}
+
+uint32_t board_millis(void)
+{
+    return board_micros() / 1000u;
+}
+
+/* Run the example firmware over n samples; returns the bytes sent, or 0 if `out` was too small. */
+size_t example_run(const int16_t *raw, const uint32_t *t_us, const int16_t *temp, uint32_t n, float sample_rate,
+                   float sensitivity, uint8_t *out, size_t cap)
+{
+    static example_t ex;
+    g_raw = raw;
+    g_t_us = t_us;
+    g_temp = temp;
+    g_n = n;
+    g_i = 0u;
+    g_out = out;
+    g_cap = cap;
+    g_len = g_dropped = 0u;
+    example_setup(&ex, sample_rate, sensitivity, temp != 0);
+    while (example_step(&ex) == 0) {
+    }
+    return g_dropped ? 0u : g_len;
+}

@@ -1,0 +1,166 @@
+"""The C library's frame encoder and on-device session, seen from Python through ctypes.
+
+:func:`firmware_stream` sends a session through the same calls, in the same order, as the
+example firmware (``examples/firmware/gyrocal_example.c``): a hello frame, then per sample a
+sample frame, the session's turn and result frames with a text line each, and corrected
+samples once calibrated. The virtual device serves these bytes, and a test checks them
+byte for byte against the example firmware compiled on the host.
+"""
+
+from __future__ import annotations
+
+import ctypes
+
+import numpy as np
+
+from ..firmware import CLibrary, load_library
+from .frames import TURN_LABELS
+
+__all__ = ["CDevice", "firmware_stream"]
+
+_F3 = ctypes.c_float * 3
+_BUF = ctypes.c_uint8 * 70  # GYROCAL_FRAME_MAX
+_PRE = 32  # GYROCAL_SESSION_PRE
+_REASONS = (" accepted", " ignored: wrong angle", " ignored: off axis", " ignored: too long")
+
+
+class _Hello(ctypes.Structure):
+    _fields_ = [("sample_rate", ctypes.c_float), ("sensitivity", ctypes.c_float), ("rate_unit", ctypes.c_uint8),
+                ("flags", ctypes.c_uint8), ("library", ctypes.c_uint16), ("firmware", ctypes.c_char * 16)]
+
+
+class _Turn(ctypes.Structure):
+    _fields_ = [("start", ctypes.c_uint32), ("stop", ctypes.c_uint32), ("rate", ctypes.c_float),
+                ("angle", ctypes.c_float), ("mean", _F3), ("slot", ctypes.c_uint8), ("status", ctypes.c_uint8)]
+
+
+class _Accum(ctypes.Structure):
+    _fields_ = [(name, _F3) for name in ("first", "s1", "c1", "s2", "c2")] + [("count", ctypes.c_uint32)]
+
+
+class _Obs(ctypes.Structure):
+    _fields_ = [("mean", _F3), ("mean_sq", _F3), ("rate", ctypes.c_float)]
+
+
+class _ScaleBias(ctypes.Structure):
+    _fields_ = [("k", _F3), ("b", _F3)]
+
+
+class _Session(ctypes.Structure):
+    """gyrocal_session_t, field for field (gyrocal_session.h)."""
+
+    _fields_ = [
+        ("sample_rate", ctypes.c_float), ("sensitivity", ctypes.c_float), ("turn_angle", ctypes.c_float),
+        ("threshold", ctypes.c_float), ("settle_n", ctypes.c_uint32), ("quiet_n", ctypes.c_uint32),
+        ("max_n", ctypes.c_uint32), ("seq", ctypes.c_uint32), ("phase", ctypes.c_uint8), ("have", ctypes.c_uint8),
+        ("ring_pos", ctypes.c_uint16), ("ring_len", ctypes.c_uint16), ("ring", (ctypes.c_int16 * 3) * _PRE),
+        ("base", _F3), ("sum", _F3), ("start", ctypes.c_uint32), ("run", ctypes.c_uint32), ("acc", _Accum),
+        ("obs", _Obs * 6), ("turn", _Turn), ("result", _ScaleBias), ("status", ctypes.c_int),
+        ("iterations", ctypes.c_int),
+    ]
+
+
+_P = ctypes.POINTER
+_U8P = _P(ctypes.c_uint8)
+_SIGNATURES = {
+    "gyrocal_crc16": (ctypes.c_uint16, [_U8P, ctypes.c_size_t, ctypes.c_uint16]),
+    "gyrocal_frame_hello": (ctypes.c_size_t, [_U8P, _P(_Hello)]),
+    "gyrocal_frame_sample": (ctypes.c_size_t, [_U8P, ctypes.c_uint32, ctypes.c_uint32, _P(ctypes.c_int16),
+                                               ctypes.c_int16]),
+    "gyrocal_frame_calibrated": (ctypes.c_size_t, [_U8P, ctypes.c_uint32, ctypes.c_uint32, _P(ctypes.c_float)]),
+    "gyrocal_frame_turn": (ctypes.c_size_t, [_U8P, _P(_Turn)]),
+    "gyrocal_frame_result": (ctypes.c_size_t, [_U8P, ctypes.c_int, ctypes.c_uint8, ctypes.c_uint8, ctypes.c_uint8,
+                                               _P(_ScaleBias), ctypes.c_uint32]),
+    "gyrocal_frame_text": (ctypes.c_size_t, [_U8P, ctypes.c_char_p]),
+    "gyrocal_session_init": (ctypes.c_int, [_P(_Session), ctypes.c_float, ctypes.c_float, ctypes.c_float]),
+    "gyrocal_session_add": (ctypes.c_uint, [_P(_Session), _P(ctypes.c_int16)]),
+    "gyrocal_scale_bias_to_affine": (None, [_P(_ScaleBias), ctypes.c_void_p]),
+    "gyrocal_correct": (None, [ctypes.c_void_p, _P(ctypes.c_float), _P(ctypes.c_float)]),
+}
+
+
+class CDevice:
+    """The frame encoders and the session of the C library (built with the host compiler)."""
+
+    def __init__(self, lib: CLibrary | None = None):
+        self.lib = lib or load_library()
+        self.dll = self.lib.dll
+        for name, (restype, argtypes) in _SIGNATURES.items():
+            fn = getattr(self.dll, name)
+            fn.restype, fn.argtypes = restype, argtypes
+        self._buf = _BUF()
+
+    def _out(self, n: int) -> bytes:
+        return bytes(self._buf[:n])
+
+    def crc16(self, data: bytes) -> int:
+        arr = (ctypes.c_uint8 * max(len(data), 1)).from_buffer_copy(data or b"\0")
+        return self.dll.gyrocal_crc16(arr, len(data), 0xFFFF)
+
+    def hello(self, sample_rate: float, sensitivity: float, *, has_temp: bool, firmware: str,
+              library: int = 0x0100, rate_unit: int = 1) -> bytes:
+        h = _Hello(sample_rate, sensitivity, rate_unit, int(has_temp), library, firmware.encode()[:16])
+        return self._out(self.dll.gyrocal_frame_hello(self._buf, ctypes.byref(h)))
+
+    def sample(self, seq: int, t_us: int, raw, temp_centi: int) -> bytes:
+        r = (ctypes.c_int16 * 3)(*(int(v) for v in raw))
+        return self._out(self.dll.gyrocal_frame_sample(self._buf, seq & 0xFFFFFFFF, t_us & 0xFFFFFFFF, r, temp_centi))
+
+    def calibrated(self, seq: int, t_us: int, w) -> bytes:
+        return self._out(self.dll.gyrocal_frame_calibrated(self._buf, seq, t_us & 0xFFFFFFFF, _F3(*w)))
+
+    def turn(self, start, stop, rate, angle, mean, slot, status) -> bytes:
+        t = _Turn(start, stop, rate, angle, _F3(*mean), slot, status)
+        return self._out(self.dll.gyrocal_frame_turn(self._buf, ctypes.byref(t)))
+
+    def result(self, status: int, method: int, iterations: int, n_turns: int, k, b, seq: int) -> bytes:
+        sb = _ScaleBias(_F3(*k), _F3(*b))
+        return self._out(self.dll.gyrocal_frame_result(self._buf, status, method, iterations, n_turns,
+                                                       ctypes.byref(sb), seq))
+
+    def text(self, text: str) -> bytes:
+        return self._out(self.dll.gyrocal_frame_text(self._buf, text.encode()))
+
+    def _events(self, s: _Session, events: int) -> bytes:
+        out = b""
+        if events & 1:
+            out += self._out(self.dll.gyrocal_frame_turn(self._buf, ctypes.byref(s.turn)))
+            out += self.text(TURN_LABELS[s.turn.slot] + _REASONS[s.turn.status if s.turn.status < 4 else 1])
+        if events & 2:
+            ok = s.status == 0
+            out += self._out(self.dll.gyrocal_frame_result(self._buf, s.status, 0, s.iterations, 6,
+                                                           ctypes.byref(s.result) if ok else None, s.seq - 1))
+        return out
+
+    def firmware_stream(self, raw, t_us, temp=None, *, sample_rate: float, sensitivity: float,
+                        firmware: str = "gyrocal-example", send_calibrated: bool = True) -> bytes:
+        """Every byte the example firmware sends for this session (see the module notes)."""
+        raw = np.asarray(raw, dtype=np.int16)
+        temp_c = None if temp is None else np.round(np.asarray(temp, dtype=float) * 100).astype(np.int16)
+        parts = [self.hello(sample_rate, sensitivity, has_temp=temp is not None, firmware=firmware)]
+        s = _Session()
+        self.dll.gyrocal_session_init(ctypes.byref(s), sample_rate, sensitivity, 360.0)
+        cal = (ctypes.c_float * 12)()
+        calibrated = False
+        r = (ctypes.c_int16 * 3)()
+        x, w = _F3(), _F3()
+        for i in range(len(raw)):
+            r[0], r[1], r[2] = (int(v) for v in raw[i])
+            t = int(t_us[i])
+            parts.append(self.sample(i, t, r, -32768 if temp_c is None else int(temp_c[i])))
+            events = self.dll.gyrocal_session_add(ctypes.byref(s), r)
+            if events:
+                parts.append(self._events(s, events))
+                if events & 2 and s.status == 0:
+                    self.dll.gyrocal_scale_bias_to_affine(ctypes.byref(s.result), cal)
+                    calibrated = True
+            if send_calibrated and calibrated:
+                x[0], x[1], x[2] = r[0], r[1], r[2]
+                self.dll.gyrocal_correct(cal, x, w)
+                parts.append(self.calibrated(i, t, w))
+        return b"".join(parts)
+
+
+def firmware_stream(raw, t_us, temp=None, *, sample_rate: float, sensitivity: float, **kwargs) -> bytes:
+    """:meth:`CDevice.firmware_stream` with the library built in the default cache."""
+    return CDevice().firmware_stream(raw, t_us, temp, sample_rate=sample_rate, sensitivity=sensitivity, **kwargs)

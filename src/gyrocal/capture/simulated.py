@@ -1,0 +1,124 @@
+"""Simulated device sessions: what a gyro on a microcontroller reads during a servo or hand session.
+
+The motion and the sensor come from :mod:`gyrocal.simulation`; this module turns the readings
+into what a device sends: raw counts (int16) at a sensitivity, microsecond time stamps of the
+device's clock and the temperature in hundredths of a degree.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._validation import positive
+from ..models import ScaleBias
+from ..simulation import ServoProtocol, VirtualGyro, simulate_servo
+from ..windows import Window
+
+__all__ = ["MPU6050_SENSITIVITY", "DeviceSession", "simulate_device_session"]
+
+#: LSB per deg/s of an MPU-6050 / MPU-9250 at +-250 deg/s.
+MPU6050_SENSITIVITY = 131.0
+
+
+@dataclass(frozen=True)
+class DeviceSession:
+    """A simulated session as the device sees it.
+
+    Attributes
+    ----------
+    raw : ndarray of int16, shape (N, 3)
+        Readings [counts].
+    t_us : ndarray of int64, shape (N,)
+        The device clock at each sample [us].
+    temp : ndarray, shape (N,), or None
+        Temperature [degC], in steps of 0.01.
+    sample_rate : float
+        Nominal rate [Hz].
+    sensitivity : float
+        [counts per deg/s].
+    model : ScaleBias
+        The true gyro, servo method of Wang et al. eq. 1, internal units (rad/s).
+    windows : tuple of Window
+        Every true turn and static stretch, in samples of this session.
+    """
+
+    raw: np.ndarray
+    t_us: np.ndarray
+    temp: np.ndarray | None
+    sample_rate: float
+    sensitivity: float
+    model: ScaleBias
+    windows: tuple[Window, ...]
+
+    def __len__(self) -> int:
+        return len(self.raw)
+
+    @property
+    def device_k(self) -> np.ndarray:
+        """True k as the device computes it [deg/s per count]."""
+        return self.model.k / self.sensitivity
+
+    @property
+    def device_b(self) -> np.ndarray:
+        """True b as the device computes it [counts]."""
+        return self.model.b * (180.0 / math.pi) * self.sensitivity
+
+    @property
+    def turns(self) -> tuple[Window, ...]:
+        return tuple(w for w in self.windows if w.kind == "rotation")
+
+
+def simulate_device_session(
+    protocols: ServoProtocol | Sequence[ServoProtocol],
+    *,
+    model: ScaleBias,
+    noise_std: float,
+    rng: np.random.Generator,
+    sample_rate: float = 200.0,
+    sensitivity: float = MPU6050_SENSITIVITY,
+    temp: float | None = 25.0,
+    clock_ppm: float = 0.0,
+) -> DeviceSession:
+    """Simulate a session (one protocol, or several played one after the other).
+
+    Parameters
+    ----------
+    protocols : ServoProtocol or sequence of ServoProtocol
+        The motion; a sequence plays its parts in turn (for example a turn done wrong,
+        then done again).
+    model : ScaleBias
+        The true gyro [rad/s].
+    noise_std : float
+        Per-sample white noise [rad/s].
+    rng : numpy.random.Generator
+        All randomness.
+    sample_rate : float
+        [Hz].
+    sensitivity : float
+        [counts per deg/s]; readings are rounded to whole counts and clipped to int16.
+    temp : float or None
+        Temperature [degC], drifting by 0.5 degC over the session; None for a device without one.
+    clock_ppm : float
+        Error of the device clock that stamps the samples [parts per million].
+    """
+    fs = positive("sample_rate", sample_rate)
+    sens = positive("sensitivity", sensitivity)
+    parts = [protocols] if isinstance(protocols, ServoProtocol) else list(protocols)
+    gyro = VirtualGyro(model, noise_std=noise_std)
+    chunks, windows, offset = [], [], 0
+    for p in parts:
+        rec, truth = simulate_servo(gyro, p, sample_rate=fs, rng=rng)
+        chunks.append(rec.gyro)
+        windows += [Window(w.start + offset, w.stop + offset, w.kind, w.axis, w.sign, w.angle, w.rate, w.label)
+                    for w in truth.windows]
+        offset += len(rec)
+    counts = np.concatenate(chunks) * (180.0 / math.pi) * sens
+    raw = np.clip(np.round(counts), -32768, 32767).astype(np.int16)
+    n = len(raw)
+    t_us = np.round(np.arange(n) * (1e6 / fs) * (1 + 1e-6 * clock_ppm)).astype(np.int64) + 1_000_000
+    t = None if temp is None else np.round((temp + 0.5 * np.arange(n) / max(n, 1)) * 100) / 100
+    return DeviceSession(raw, t_us, t, fs, sens, model, tuple(windows))

@@ -1,0 +1,174 @@
+"""Text lines as an Arduino ``Serial.println`` sends them: ``t,gx,gy,gz[,temp]``.
+
+The first line whose fields are names is the header; columns are found by gyrocal's names
+and aliases (as in a CSV file), and a time column named ``t_ms``/``millis`` or ``t_us``/
+``micros`` is scaled to seconds. Without a header, ``columns`` gives column numbers,
+counting from 1 (``{"t": 1, "gx": 2, "gy": 3, "gz": 4}``). A line that is not a sample is
+skipped and counted, never fatal; lines starting with ``#`` are messages from the device.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from ..errors import InputError
+from ..io.columns import resolve, time_scale
+
+__all__ = ["Reading", "TextDecoder", "TextStats"]
+
+_MAX_LINE = 512  # a longer line is noise (a baud mismatch reads as long garbage)
+_SEPARATORS = (",", ";", "\t", " ")
+
+
+@dataclass(frozen=True)
+class Reading:
+    """One sample from a text line: ``t`` [s] or None, ``g`` [the data's unit], ``temp`` [degC] or None."""
+
+    t: float | None
+    g: tuple[float, float, float]
+    temp: float | None = None
+
+
+@dataclass
+class TextStats:
+    """What a text decoder saw."""
+
+    bytes: int = 0
+    lines: int = 0
+    samples: int = 0
+    bad_lines: int = 0       # not a sample: wrong field count, non-numbers, too long, not text
+    before_header: int = 0   # numeric lines before a header told what the columns are
+    messages: list[str] = field(default_factory=list)  # '#' lines and text before the header (last 20)
+
+
+def _split(line: str) -> list[str]:
+    for sep in _SEPARATORS:
+        if sep in line:
+            return [f.strip() for f in line.split(sep) if sep != " " or f.strip()]
+    return [line.strip()]
+
+
+def _numbers(fields: list[str]) -> list[float] | None:
+    try:
+        return [float(f) for f in fields]
+    except ValueError:
+        return None
+
+
+class TextDecoder:
+    """Streaming decoder of text lines: ``feed(bytes) -> list of Reading``.
+
+    Parameters
+    ----------
+    columns : mapping of str to int or str, optional
+        Column numbers counting from 1 (no header needed), or names mapping gyrocal's
+        names to the header's (as ``--columns`` for files).
+    """
+
+    def __init__(self, columns=None):
+        self._buf = bytearray()
+        self._numbers: dict[str, int] | None = None
+        self._names = None
+        self._t_scale = 1.0
+        self.stats = TextStats()
+        if columns:
+            if all(str(v).strip().isdigit() for v in columns.values()):
+                cols = {k: int(v) - 1 for k, v in columns.items()}
+                if min(cols.values()) < 0:
+                    raise InputError(f"column numbers count from 1, got columns={columns!r}")
+                self._use(cols, 1.0)
+            else:
+                self._names = dict(columns)
+
+    @property
+    def has_layout(self) -> bool:
+        """Whether the decoder knows which field is which (a header came, or columns were given)."""
+        return self._numbers is not None
+
+    @property
+    def has_time(self) -> bool:
+        return self._numbers is not None and "t" in self._numbers
+
+    @property
+    def has_temp(self) -> bool:
+        return self._numbers is not None and "temp" in self._numbers
+
+    def _use(self, cols: dict[str, int], t_scale: float) -> None:
+        missing = [c for c in ("gx", "gy", "gz") if c not in cols]
+        if missing:
+            raise InputError(f"columns gives no number for {', '.join(missing)}")
+        self._numbers, self._t_scale = cols, t_scale
+        self._width = max(cols.values()) + 1
+
+    def _message(self, text: str) -> None:
+        msgs = self.stats.messages
+        msgs.append(text[:200])
+        del msgs[:-20]
+
+    def _header(self, fields: list[str]) -> bool:
+        try:
+            mapping = resolve(fields, self._names, "the serial header line")
+        except InputError:
+            return False
+        cols = {k: fields.index(v) for k, v in mapping.items() if k in ("t", "gx", "gy", "gz", "temp")}
+        self._use(cols, time_scale(mapping["t"]) if "t" in mapping else 1.0)
+        return True
+
+    def _line(self, raw: bytes, out: list[Reading]) -> None:
+        st = self.stats
+        st.lines += 1
+        try:
+            line = raw.decode("ascii").strip()
+        except UnicodeDecodeError:
+            st.bad_lines += 1
+            return
+        if not line:
+            return
+        if line.startswith("#"):
+            self._message(line.lstrip("# "))
+            return
+        fields = _split(line)
+        values = _numbers(fields)
+        if values is None:
+            if not (self._numbers is None and self._header(fields)):
+                if self._numbers is None:
+                    self._message(line)
+                else:
+                    st.bad_lines += 1
+            return
+        if self._numbers is None:
+            st.before_header += 1
+            return
+        if len(values) < self._width or not all(math.isfinite(v) for v in values):
+            st.bad_lines += 1
+            return
+        c = self._numbers
+        t = values[c["t"]] * self._t_scale if "t" in c else None
+        temp = values[c["temp"]] if "temp" in c else None
+        out.append(Reading(t, (values[c["gx"]], values[c["gy"]], values[c["gz"]]), temp))
+        st.samples += 1
+
+    def feed(self, data: bytes) -> list[Reading]:
+        self.stats.bytes += len(data)
+        self._buf += data
+        out: list[Reading] = []
+        *lines, rest = self._buf.split(b"\n")
+        for raw in lines:
+            if len(raw) > _MAX_LINE:
+                self.stats.lines += 1
+                self.stats.bad_lines += 1
+            else:
+                self._line(bytes(raw), out)
+        if len(rest) > _MAX_LINE:  # no newline in sight: garbage, drop it
+            self.stats.bad_lines += 1
+            rest = b""
+        self._buf = bytearray(rest)
+        return out
+
+    def finish(self) -> None:
+        """The stream ended: a last line without its newline may be cut short, so it is counted, not used."""
+        if self._buf.strip():
+            self.stats.lines += 1
+            self.stats.bad_lines += 1
+        self._buf = bytearray()

@@ -1,0 +1,50 @@
+"""The library's option vocabularies, as ``Literal`` types.
+
+Each option that takes one of a few words is typed here once; the modules that use it
+import it from here, and the command line builds its choices from the same types.
+This module imports nothing heavy, so ``gyrocal --help`` does not load numpy.
+"""
+
+from __future__ import annotations
+
+from typing import Literal, get_args
+
+__all__ = [
+    "AccelUnit",
+    "DesignName",
+    "InputUnit",
+    "Method",
+    "OutOfRange",
+    "Protocol",
+    "RateUnit",
+    "SaturationPolicy",
+    "StudyName",
+    "TableModel",
+    "values",
+]
+
+#: Angular-rate units a user may read or write; inside gyrocal everything is rad/s.
+RateUnit = Literal["rad/s", "deg/s"]
+#: Units a gyro recording may be in; ``counts`` are raw integers, optionally with a sensitivity.
+InputUnit = Literal["rad/s", "deg/s", "counts"]
+#: Units of accelerometer columns; inside gyrocal accelerations are m/s^2.
+AccelUnit = Literal["m/s^2", "g", "counts"]
+#: Estimators of the scale-bias model (see :mod:`gyrocal.estimators`).
+Method = Literal["first-moment", "algorithm1", "lm"]
+#: What happens to samples stuck at the sensor's full scale.
+SaturationPolicy = Literal["error", "drop", "ignore"]
+#: Temperatures outside a thermal table's calibrated range.
+OutOfRange = Literal["refuse", "clamp", "extrapolate"]
+#: How a thermal table is evaluated in temperature ("traditional": the paper's one-temperature baseline).
+TableModel = Literal["lagrange", "smooth", "traditional"]
+#: Motion sources of ``gyrocal simulate`` (see :mod:`gyrocal.simulation`).
+Protocol = Literal["servo", "hand", "turntable", "profile"]
+#: Monte Carlo studies reproducing the papers (see :mod:`gyrocal.studies`).
+StudyName = Literal["servo-normal", "servo-extreme", "servo-speed", "servo-convergence", "thermal-compare"]
+#: Experimental designs of the planner (see :mod:`gyrocal.planning`).
+DesignName = Literal["six", "six-static", "twelve"]
+
+
+def values(choice) -> tuple[str, ...]:
+    """The words a ``Literal`` type admits, in order."""
+    return get_args(choice)

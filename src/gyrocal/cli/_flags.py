@@ -1,0 +1,72 @@
+"""Library parameter names and the command-line flags that set them.
+
+Library errors name the Python parameter at fault (``GyrocalError.param``); the error
+boundary shows the flag instead, through :func:`flag`. A test checks that every
+``param=`` the library raises with is either here or in :data:`NOT_FLAGS`.
+"""
+
+from __future__ import annotations
+
+__all__ = ["FLAGS", "NOT_FLAGS", "flag"]
+
+#: Python parameter -> flag.
+FLAGS: dict[str, str] = {
+    # reading
+    "units": "--units",
+    "columns": "--columns",
+    "sample_rate": "--sample-rate",
+    "sensitivity": "--sensitivity",
+    "output_units": "--output-units",
+    "topic": "--topic",
+    "saturation": "--saturation",
+    "check_units": "--no-unit-check",
+    "full_scale": "--full-scale",
+    "accel_units": "--accel-units",
+    "accel_sensitivity": "--accel-sensitivity",
+    "gravity": "--gravity",
+    # calibrate
+    "speed": "--speed",
+    "angle": "--angle",
+    "windows": "--windows",
+    "method": "--method",
+    "noise_std": "--noise-std",
+    "noise_density": "--noise-density",
+    # apply, export
+    "model": "--model",
+    "out_of_range": "--out-of-range",
+    "temp_tau": "--temp-tau",
+    "fmt": "--format",
+    "prefix": "--prefix",
+    # thermal
+    "settle": "--settle",
+    "temp_tolerance": "--temp-tolerance",
+    "reference_temp": "--ref-temp",
+    "max_order": "--max-order",
+    # simulate
+    "turns": "--turns",
+    "wait": "--wait",
+    "ramp": "--ramp",
+    "vibration": "--vibration",
+    "misalignment_deg": "--misalignment",
+    "temps": "--temps",
+    "rates": "--rates",
+    "step_duration": "--step-duration",
+    "temp_noise": "--temp-noise",
+    "temp_quantum": "--temp-quantum",
+    "duration": "--duration",
+    "quantum": "--quantum",
+    "bias_instability": "--bias-instability",
+    "rate_random_walk": "--rrw",
+}
+
+#: Parameters that library errors name but that no flag sets (the command line fills them itself).
+NOT_FLAGS: frozenset[str] = frozenset({
+    "accel_source_units", "covariance", "correction", "accelerometer", "fit", "observed",
+    "chi2", "dof", "p_value", "birge_ratio", "covariance_scaled", "residuals", "warnings", "noise_std_axes",
+    "max_abs_rate",
+})
+
+
+def flag(param: str) -> str:
+    """The flag that sets library parameter `param` (the parameter's own name when no flag does)."""
+    return FLAGS.get(param, param)

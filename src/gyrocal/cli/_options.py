@@ -1,0 +1,72 @@
+"""Small helpers shared by command modules: which flags were typed, and lists of numbers."""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Optional
+
+import typer
+
+from ..errors import InputError
+
+__all__ = ["NoiseDensity", "given", "noise_std", "numbers", "refuse_unused", "triple"]
+
+
+def given(ctx: typer.Context, name: str) -> bool:
+    """Whether parameter `name` was typed on the command line rather than left at its default."""
+    source = ctx.get_parameter_source(name)
+    return source is not None and source.name == "COMMANDLINE"
+
+
+def refuse_unused(ctx: typer.Context, users: dict[str, tuple[str, ...]], choice: str, what: str) -> None:
+    """Refuse a flag given on the command line that `choice` does not use: ignoring it would mislead.
+
+    `users` maps a parameter name to the choices that use it; parameters not in it apply to all.
+    """
+    for param in ctx.command.params:
+        if param.name in users and choice not in users[param.name] and given(ctx, param.name):
+            flag = max(param.opts, key=len)
+            raise InputError(f"{flag} does not apply to {what} {choice} (only to {', '.join(users[param.name])}); "
+                             "drop it")
+
+
+def numbers(name: str, text: str) -> list[float]:
+    """Comma-separated finite numbers."""
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise InputError(f"{name} must be comma-separated numbers, got {text!r}") from None
+    if not all(map(math.isfinite, values)):
+        raise InputError(f"{name} must be finite numbers, got {text!r}")
+    return values
+
+
+def triple(name: str, text: str | None, default) -> list[float]:
+    """Three comma-separated numbers, or `default` when `text` is None."""
+    if text is None:
+        return [float(v) for v in default]
+    values = numbers(name, text)
+    if len(values) != 3:
+        raise InputError(f"{name} must be three comma-separated numbers, got {text!r}")
+    return values
+
+
+NoiseDensity = Annotated[Optional[str], typer.Option(
+    "--noise-density",
+    help="White-noise density: rad/s/sqrt(Hz), 'N deg/s/rtHz', or a noise JSON from 'gyrocal noise --json'.")]
+
+
+def noise_std(noise: float | None, density: str | None, sample_rate: float, default: float):
+    """Per-sample white noise (3,) [rad/s] from --noise or --noise-density."""
+    import numpy as np
+
+    from ..noise import noise_density_arg
+
+    if noise is not None and density is not None:
+        raise InputError("give --noise or --noise-density, not both")
+    if density is not None:
+        return noise_density_arg(density) * math.sqrt(sample_rate)
+    value = default if noise is None else noise
+    if not (math.isfinite(value) and value >= 0):
+        raise InputError(f"--noise must be >= 0 rad/s, got {value:g}")
+    return np.full(3, value)

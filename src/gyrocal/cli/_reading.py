@@ -1,0 +1,87 @@
+"""The reading flags, defined once, and the one function that turns them into a Recording.
+
+A command takes the flags it needs as parameters typed with the attributes of
+:data:`READING` (``units: READING.Units = None``); a command that reads two recordings
+makes a second set with a prefix (``ReadingFlags("ref-")`` gives ``--ref-units`` ...).
+:func:`read_from_flags` passes them to :func:`gyrocal.io.read_recording`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ..choices import SaturationPolicy
+from ..errors import InputError
+
+__all__ = ["READING", "ReadingFlags", "read_from_flags", "required_units"]
+
+STANDARD_GRAVITY = 9.80665  # m/s^2; the library's default (gyrocal.io._build.STANDARD_GRAVITY)
+
+
+class ReadingFlags:
+    """The ``Annotated`` types of the reading flags, for one flag prefix (``""`` or ``"ref-"``)."""
+
+    def __init__(self, prefix: str = ""):
+        def opt(name: str, help: str):
+            return typer.Option(f"--{prefix}{name}", help=help)
+
+        self.Units = Annotated[Optional[str], opt("units", "Unit of the gyro columns: rad/s, deg/s or counts.")]
+        self.Columns = Annotated[Optional[str], opt(
+            "columns", "Map gyrocal names to the file's, e.g. gx=gyroX,gy=gyroY,gz=gyroZ[,t=time,temp=T,ax=accX].")]
+        self.SampleRate = Annotated[Optional[float], opt(
+            "sample-rate", "Nominal sample rate [Hz]; needed when the file has no time column.")]
+        self.Sensitivity = Annotated[Optional[float], opt(
+            "sensitivity", "For --units counts: LSB per --output-units rate unit.")]
+        self.OutputUnits = Annotated[Optional[str], opt(
+            "output-units", "Unit of corrected rates, rad/s or deg/s (default: the data's; deg/s for counts).")]
+        self.Topic = Annotated[Optional[str], opt("topic", "sensor_msgs/Imu topic in a ROS 1/ROS 2/MCAP bag.")]
+        self.Saturation = Annotated[SaturationPolicy, opt(
+            "saturation", "Samples stuck at full scale: refuse (error), drop them, or ignore.")]
+        self.NoUnitCheck = Annotated[bool, opt(
+            "no-unit-check", "Accept rates that look like another unit (e.g. 4000 'rad/s').")]
+        self.AccelUnits = Annotated[Optional[str], opt(
+            "accel-units", "Unit of the accelerometer columns (ax, ay, az or acc_x, ...): m/s^2, g or counts.")]
+        self.AccelSensitivity = Annotated[Optional[float], opt(
+            "accel-sensitivity", "For --accel-units counts: LSB per g.")]
+        self.Gravity = Annotated[float, opt("gravity", "One g [m/s^2], for --accel-units g or counts.")]
+
+
+#: The reading flags without a prefix.
+READING = ReadingFlags()
+
+
+def required_units(units: str | None) -> str:
+    """The --units value, which the command cannot do without."""
+    from ..units import parse_input_unit
+
+    if units is None:
+        raise InputError("{param} is required: rad/s, deg/s or counts (the unit of the gyro columns)", param="units")
+    return parse_input_unit(units, "units")
+
+
+def read_from_flags(
+    path: Path,
+    *,
+    units: str,
+    columns: str | None = None,
+    sample_rate: float | None = None,
+    sensitivity: float | None = None,
+    output_units: str | None = None,
+    topic: str | None = None,
+    saturation: SaturationPolicy = "error",
+    no_unit_check: bool = False,
+    accel_units: str | None = None,
+    accel_sensitivity: float | None = None,
+    gravity: float = STANDARD_GRAVITY,
+    need_accel: bool = False,
+):
+    """A :class:`~gyrocal.recording.Recording` from the reading flags (see :func:`gyrocal.io.read_recording`)."""
+    from ..io import read_recording
+
+    return read_recording(path, units=units, columns=columns, sample_rate=sample_rate, sensitivity=sensitivity,
+                          output_units=output_units, topic=topic, check_units=not no_unit_check,
+                          saturation=saturation, accel_units=accel_units, accel_sensitivity=accel_sensitivity,
+                          gravity=gravity, need_accel=need_accel)

@@ -1,0 +1,140 @@
+"""The example firmware (examples/firmware), compiled on the host with a fake board layer that plays a
+simulated session, and the frames it sends.
+
+Independent references: the simulated session itself (the samples, time stamps and temperatures
+fed to the fake board; the true turns and the true gyro of the simulation), the host's float64
+recomputation of the device's float32 arithmetic within the rounding bounds of
+tests/test_firmware.py, and the first-moment covariance for the statistical check against the truth.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gyrocal import firmware
+from gyrocal.capture import frames as fr
+from gyrocal.capture.agreement import C_ROUND, EPS32, check_device
+from gyrocal.capture.c_device import CDevice
+from gyrocal.capture.simulated import simulate_device_session
+from gyrocal.estimators import FirstMoment
+from gyrocal.models import ScaleBias
+from gyrocal.observations import ObservationSet
+from gyrocal.simulation import ServoProtocol
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "firmware"
+NOISE = 0.01  # rad/s per sample
+MODEL = ScaleBias(k=np.array([1.03, 0.97, 1.01]), b=np.radians([1.5, -2.0, 0.8]))
+
+
+@pytest.fixture(scope="module")
+def example(tmp_path_factory):
+    """The example firmware with the fake board, as a shared library (host compiler, strict C99)."""
+    path = firmware.build_library(tmp_path_factory.mktemp("example"), include_dirs=[EXAMPLE],
+                                  extra_sources=[EXAMPLE / "gyrocal_example.c", EXAMPLE / "host_board.c"])
+    dll = ctypes.CDLL(str(path))
+    dll.example_run.restype = ctypes.c_size_t
+    dll.example_run.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_uint32, ctypes.c_float,
+                                ctypes.c_float, ctypes.c_void_p, ctypes.c_size_t]
+    return dll, CDevice(firmware.load_library(path.parent))
+
+
+def run_example(dll, s) -> bytes:
+    raw = np.ascontiguousarray(s.raw, dtype=np.int16)
+    t = np.ascontiguousarray(s.t_us, dtype=np.uint32)
+    temp = None if s.temp is None else np.ascontiguousarray(np.round(s.temp * 100), dtype=np.int16)
+    out = np.zeros(64 * len(raw) + 1024, dtype=np.uint8)
+    n = dll.example_run(raw.ctypes.data, t.ctypes.data, None if temp is None else temp.ctypes.data, len(raw),
+                        s.sample_rate, s.sensitivity, out.ctypes.data, len(out))
+    assert n > 0
+    return out[:n].tobytes()
+
+
+@pytest.fixture(scope="module")
+def session():
+    """A wrong turn (+x by 270 deg), then the paper's six turns at 60 deg/s with 3 deg of misalignment."""
+    rng = np.random.default_rng(16)
+    wrong = ServoProtocol(turns=("+x",), revolutions=0.75, lead_in=1.0, lead_out=1.0, misalignment_deg=3.0)
+    return simulate_device_session([wrong, ServoProtocol(lead_in=1.0, misalignment_deg=3.0)], model=MODEL,
+                                   noise_std=NOISE, rng=rng)
+
+
+@pytest.fixture(scope="module")
+def sent(example, session):
+    dll, _ = example
+    return run_example(dll, session)
+
+
+def by_type(frames, cls):
+    return [f for f in frames if isinstance(f, cls)]
+
+
+def test_virtual_device_sends_the_firmware_bytes(example, session, sent):
+    """The Python-driven C session (the virtual device) is the example firmware, byte for byte."""
+    _, cdev = example
+    assert cdev.firmware_stream(session.raw, session.t_us, session.temp, sample_rate=session.sample_rate,
+                                sensitivity=session.sensitivity) == sent
+
+
+def test_samples_arrive_as_sent(session, sent):
+    dec = fr.FrameDecoder()
+    frames = dec.feed(sent)
+    samples = by_type(frames, fr.Sample)
+    assert dec.stats.skipped == dec.stats.crc_errors == dec.stats.lost_samples == 0
+    assert [f.seq for f in samples] == list(range(len(session)))
+    np.testing.assert_array_equal([f.raw for f in samples], session.raw)
+    np.testing.assert_array_equal([f.t_us for f in samples], session.t_us)
+    np.testing.assert_allclose([f.temp for f in samples], session.temp, atol=1e-9)
+    hello = frames[0]
+    assert isinstance(hello, fr.Hello) and hello.sample_rate == 200 and hello.sensitivity == 131 and hello.has_temp
+
+
+def test_turns_cover_the_true_turns_and_the_wrong_one_is_refused(session, sent):
+    frames = fr.FrameDecoder().feed(sent)
+    turns = by_type(frames, fr.Turn)
+    truth = session.turns
+    assert [t.label for t in turns] == [w.label for w in truth]
+    for t, w in zip(turns, truth):
+        assert t.start <= w.start and t.stop >= w.stop, (t, w)  # the whole turn is inside the window
+        assert t.stop - w.stop <= 0.55 * session.sample_rate  # ... with at most the quiet time after it
+        assert abs(t.angle - math.degrees(w.angle)) < 0.1 * math.degrees(w.angle)
+    assert turns[0].reason == "wrong angle" and all(t.reason is None for t in turns[1:])
+    texts = [f.text for f in by_type(frames, fr.Text)]
+    assert texts[0] == "+x ignored: wrong angle" and texts[1] == "+x accepted"
+
+
+def test_device_result_agrees_with_the_host_and_the_truth(session, sent):
+    frames = fr.FrameDecoder().feed(sent)
+    (result,) = by_type(frames, fr.Result)
+    assert result.status == 0 and result.n_turns == 6
+    latest = {t.slot: t for t in by_type(frames, fr.Turn) if t.status == 0}
+    samples = {s: session.raw[t.start: t.stop].astype(float) for s, t in latest.items()}
+    agreement = check_device(latest, result, samples)
+    assert agreement.agrees, agreement.report()
+    # Against the truth, within 4 sigma of the first-moment covariance at the simulated noise.
+    mean = np.array([latest[s].mean for s in range(6)], float)
+    count = np.array([latest[s].stop - latest[s].start for s in range(6)], float)
+    rate = np.array([latest[s].rate for s in range(6)], float)
+    noise_counts = math.degrees(NOISE) * session.sensitivity
+    fit = FirstMoment(noise_std=noise_counts).fit(
+        ObservationSet(mean, mean**2, np.zeros((6, 3)), rate, count, count / 200, np.zeros(6, bool)))
+    sigma = np.sqrt(np.diag(fit.covariance))
+    err = np.concatenate([result.k, result.b]) - np.concatenate([session.device_k, session.device_b])
+    assert np.all(np.abs(err) <= 4 * sigma), err / sigma
+
+
+def test_calibrated_samples_are_the_device_correction(session, sent):
+    frames = fr.FrameDecoder().feed(sent)
+    (result,) = by_type(frames, fr.Result)
+    cal = by_type(frames, fr.Calibrated)
+    assert [c.seq for c in cal] == list(range(result.seq, len(session)))
+    k, b = np.array(result.k, float), np.array(result.b, float)
+    m = session.raw[result.seq:].astype(float)
+    w = np.array([c.w for c in cal])
+    # gyrocal_correct: one subtraction and one multiply-add chain per axis, in float32
+    tol = C_ROUND * EPS32 * np.abs(k) * (np.abs(m) + np.abs(b))
+    assert np.all(np.abs(w - k * (m + b)) <= tol)
