@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from ._mpl import new_figure
 from .calibration import AXIS_COLORS
+from .figure import new_figure
 
 __all__ = ["default_stretch", "error_figure", "overlay_figure", "plot_errors", "plot_overlay"]
 

@@ -123,15 +123,18 @@ def simulate_reference(
     if len(t) != len(w) or len(t) < 2:
         raise InputError(f"t_test and rates must have one row per sample (>= 2), got {len(t)} and {len(w)}")
     fs = positive("sample_rate", sample_rate)
-    if not (math.isfinite(time_offset_s) and math.isfinite(clock_drift_ppm) and abs(clock_drift_ppm) < 1e5):
-        raise InputError(f"time_offset_s and clock_drift_ppm must be finite (|drift| < 1e5 ppm), "
-                         f"got {time_offset_s!r} and {clock_drift_ppm!r}")
+    if not math.isfinite(time_offset_s):
+        raise InputError(f"{{param}} must be a finite time [s], got {time_offset_s!r}", param="time_offset_s")
+    if not (math.isfinite(clock_drift_ppm) and abs(clock_drift_ppm) < 1e5):
+        raise InputError(f"{{param}} must be finite and below 1e5 ppm in size, got {clock_drift_ppm!r}",
+                         param="clock_drift_ppm")
     rot = _mounting(mounting_rotation, mounting_deg, rng)
     scale = 1.0 + clock_drift_ppm * 1e-6
     first = math.ceil((t[0] - time_offset_s) / scale * fs)
     last = math.floor((t[-1] - time_offset_s) / scale * fs)
     if last - first < 1:
-        raise InputError(f"a reference at {fs:g} Hz gets fewer than 2 samples within the test log's span")
+        raise InputError(f"a reference at {fs:g} Hz gets fewer than 2 samples within the test log's span",
+                         param="sample_rate")
     t_ref = np.arange(first, last + 1) / fs
     t_on_test = np.clip(t_ref * scale + time_offset_s, t[0], t[-1])  # rounding at the ends
     body = np.stack([np.interp(t_on_test, t, w[:, j]) for j in range(3)], axis=1)
@@ -144,9 +147,10 @@ def simulate_reference(
 def _mounting(mounting_rotation, mounting_deg: float, rng: np.random.Generator) -> np.ndarray:
     if mounting_rotation is None:
         if not 0 <= mounting_deg <= 180:
-            raise InputError(f"mounting_deg must be in [0, 180] deg, got {mounting_deg!r}")
+            raise InputError(f"{{param}} must be in [0, 180] deg, got {mounting_deg!r}", param="mounting_deg")
         return np.array(_random_rotation(float(mounting_deg), rng))
     rot = finite_array("mounting_rotation", mounting_rotation, shape_tail=(3, 3), ndim=2)
     if not (np.allclose(rot @ rot.T, np.eye(3), atol=1e-9) and np.linalg.det(rot) > 0):
-        raise InputError("mounting_rotation must be a proper rotation matrix (orthonormal, determinant +1)")
+        raise InputError("{param} must be a proper rotation matrix (orthonormal, determinant +1)",
+                         param="mounting_rotation")
     return rot.copy()

@@ -5,7 +5,8 @@ beside a high-grade reference (Tables IV-V, Figs. 7-10). Two sensors, two clocks
 
 * :func:`align` finds the clock offset and drift and the mounting rotation between two
   logs of one motion, with their 1-sigma;
-* :func:`verify_rates` compares calibrated and raw readings with the aligned reference:
+* :func:`verify_calibration` (and :func:`verify_rates` on arrays) compares calibrated and raw
+  readings with the aligned reference:
   MSE as in the paper's Table V, RMSE, 99th percentile and reduction per axis, with
   block-bootstrap 1-sigma and the reference's own noise floor;
 * :func:`compare_calibrations` compares calibrations of one unit parameter by parameter.
@@ -16,16 +17,7 @@ Numerics only: no files, no command line.
 from .alignment import Alignment, AlignmentError, align
 from .metrics import FIGURES, Metrics, error_metrics
 from .report import VerifyReport
-from .run import VerifySeries, verify_rates
+from .run import VerifySeries, verify_calibration, verify_rates
 
-__all__ = [
-           "FIGURES",
-           "Alignment",
-           "AlignmentError",
-           "Metrics",
-           "VerifyReport",
-           "VerifySeries",
-           "align",
-           "error_metrics",
-           "verify_rates",
-]
+__all__ = ["FIGURES", "Alignment", "AlignmentError", "Metrics", "VerifyReport", "VerifySeries", "align", "error_metrics",
+           "verify_calibration", "verify_rates"]

@@ -25,12 +25,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
-from .. import __version__
 from .._jsonfile import check_header, get, get_array
+from .._version import __version__
 from ..errors import FileFormatError
+from ..files import register
 from ..units import RateUnit, parse_rate_unit, unit_factor
 from .alignment import Alignment
 from .metrics import FIGURES, Metrics
@@ -43,6 +45,7 @@ AXES = ("x", "y", "z")
 COVARIANCE_ORDER = ("time_offset_s", "clock_drift_ppm", "phi_x_rad", "phi_y_rad", "phi_z_rad")
 
 
+@register
 @dataclass(frozen=True)
 class VerifyReport:
     """A calibration checked against a reference gyro.
@@ -77,8 +80,8 @@ class VerifyReport:
     inputs: dict = field(default_factory=dict)
     warnings: tuple[str, ...] = ()
 
-    FORMAT = FORMAT
-    VERSION = VERSION
+    FORMAT: ClassVar[str] = FORMAT
+    VERSION: ClassVar[int] = VERSION
 
     def to_document(self) -> dict:
         """The JSON-ready document (see the module docstring)."""

@@ -13,18 +13,20 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._validation import finite_array
-from ..errors import InputError
+from ..errors import InputError, UnitError
+from ..recording import Recording
 from ..units import RateUnit, parse_rate_unit, unit_factor
 from .alignment import align
 from .metrics import error_metrics
 from .report import AXES, VerifyReport
 from .whitenoise import second_difference_noise
 
-__all__ = ["VerifySeries", "verify_rates"]
+__all__ = ["VerifySeries", "verify_calibration", "verify_rates"]
 
 OVERLAP_WARNING = 0.9  # fraction of the test log the reference should cover
 FIT_WARNING = 3.0  # residual RMS over the noise of both sensors
 FLOOR_WARNING = 0.5  # share of the MSE after calibration that the reference's noise makes up
+WORSE_WARNING_PCT = 1.0  # MSE increase [%] that is worth a warning (when also beyond 2 sigma)
 UNRESOLVED_WARNING = 0.05  # share of it that motion too fast for the reference may add
 
 
@@ -76,9 +78,11 @@ def _warnings(alignment, t_test, metrics, unresolved: np.ndarray, units: str) ->
         if r > FIT_WARNING:
             out.append(f"after calibration the {ax} axis differs from the reference by {r:.1f}x the noise of both "
                        "sensors: the calibration leaves a systematic error there (see the figures)")
-    worse = [ax for ax, red in zip(AXES, metrics.values["reduction_pct"]) if red < 0]
+    worse = [ax for ax, red, sd in zip(AXES, metrics.values["reduction_pct"], metrics.std["reduction_pct"])
+             if red < min(-2.0 * sd, -WORSE_WARNING_PCT)]
     if worse:
-        out.append(f"calibration made axis {', '.join(worse)} worse against the reference")
+        out.append(f"calibration made axis {', '.join(worse)} worse against the reference (by more than "
+                   f"{WORSE_WARNING_PCT:g} % of the MSE and 2 sigma)")
     share = metrics.values["reference_floor"] / np.maximum(metrics.values["mse_after"], np.finfo(float).tiny)
     for ax, s in zip(AXES, share):
         if s > FLOOR_WARNING:
@@ -151,3 +155,35 @@ def verify_rates(t_test, raw, calibrated, t_ref, w_ref, *, units: RateUnit, seed
                           inputs=dict(inputs or {}),
                           warnings=tuple(_warnings(alignment, t_test, metrics, unresolved, units)))
     return report, series
+
+
+def verify_calibration(calibration, test: Recording, reference: Recording, *, seed: int = 0, fit_drift: bool = True,
+                       replicates: int = 1000, inputs: dict | None = None, **apply_options,
+                       ) -> tuple[VerifyReport, VerifySeries]:
+    """Verify a calibration (any kind with ``apply``) on a test log against a reference log.
+
+    Parameters
+    ----------
+    calibration : Calibration or ThermalCalibration
+        Applied to `test` with `apply_options` (thermal: ``model``, ``out_of_range``); a
+        thermal table needs a ``temp`` column in the test log.
+    test : Recording
+        The calibrated gyro's log, read in the calibration's input units.
+    reference : Recording
+        The reference gyro's log, in rates (not raw counts).
+    seed, fit_drift, replicates, inputs
+        As for :func:`verify_rates`.
+
+    Returns
+    -------
+    report : VerifyReport
+        Figures in the calibration's output unit.
+    series : VerifySeries
+    """
+    if reference.units != "rad/s":
+        raise UnitError("the reference log is in raw counts without a sensitivity; its rates are needed",
+                        param="reference", hint="give the reference's sensitivity in LSB per unit")
+    corrected = calibration.apply(test, **apply_options)
+    raw = np.asarray(test.gyro) if test.units == "rad/s" else None  # counts without a sensitivity: no raw rates
+    return verify_rates(test.t, raw, corrected.gyro, reference.t, reference.gyro, units=calibration.output_units,
+                        seed=seed, fit_drift=fit_drift, replicates=replicates, inputs=inputs)
