@@ -45,7 +45,7 @@ def test_other_designs_are_less_efficient():
 
 def test_crb_of_the_six_design_has_the_closed_form():
     """k = 1, b = 0: each scale factor is seen by two windows of N samples, so
-    sd(k) = sigma / sqrt(2 N) / omega (SPEC: sigma/sqrt(N) k^2/(sqrt 2 omega))."""
+    sd(k) = sigma / sqrt(2 N) / omega (docs/core.md: sigma/sqrt(N) k^2/(sqrt 2 omega))."""
     sd = predicted_std(Design.paper_six(SPEED), noise_std=0.035, sample_rate=200.0)
     n = round(2 * math.pi / SPEED * 200)
     np.testing.assert_allclose(sd[:3], 0.035 / math.sqrt(2 * n) / SPEED, rtol=1e-12)

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
 import pytest
 
 from gyrocal.errors import InputError
@@ -10,8 +12,6 @@ from gyrocal.io import read_recording, write_csv
 
 
 def test_parquet_round_trip(tmp_path, rng):
-    pa = pytest.importorskip("pyarrow")
-    pq = pytest.importorskip("pyarrow.parquet")
     n = 64
     g = rng.normal(0, 0.02, (n, 3)) + [0.5, -1.0, 2.0]  # constant turns with MEMS-like noise [rad/s]
     t = 1000.0 + np.arange(n) / 200.0
@@ -26,8 +26,6 @@ def test_parquet_round_trip(tmp_path, rng):
 
 
 def test_parquet_timestamp_and_text_columns(tmp_path):
-    pa = pytest.importorskip("pyarrow")
-    pq = pytest.importorskip("pyarrow.parquet")
     stamps = np.array([0, 5_000_000, 10_000_000], dtype="datetime64[ns]")
     pq.write_table(pa.table({"t": stamps, "gx": ["1", "2", "3"], "gy": [0.0] * 3, "gz": [0.0] * 3}), tmp_path / "a.parquet")
     rec = read_recording(tmp_path / "a.parquet", units="rad/s")
@@ -63,7 +61,6 @@ def _imu_messages(typestore, n, ros1=False):
 
 @pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
 def test_ros2_bags(tmp_path, storage):
-    pytest.importorskip("rosbags")
     from rosbags.rosbag2 import StoragePlugin, Writer
     from rosbags.typesys import Stores, get_typestore
 
@@ -90,7 +87,6 @@ def test_ros2_bags(tmp_path, storage):
 
 
 def test_ros1_bag(tmp_path):
-    pytest.importorskip("rosbags")
     from rosbags.rosbag1 import Writer
     from rosbags.typesys import Stores, get_typestore
 
@@ -106,7 +102,6 @@ def test_ros1_bag(tmp_path):
 
 
 def test_bag_without_imu_lists_topics(tmp_path):
-    pytest.importorskip("rosbags")
     from rosbags.rosbag1 import Writer
     from rosbags.typesys import Stores, get_typestore
 

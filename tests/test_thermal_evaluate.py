@@ -9,7 +9,7 @@ from gyrocal.simulation.thermal_truth import ThermalTruth
 from gyrocal.simulation.turntable import TurntableProtocol, simulate_turntable
 from gyrocal.thermal import calibrate_thermal
 from gyrocal.thermal.evaluate import METHODS, evaluate, loto_comparison
-from gyrocal.thermal.report import markdown_table, write_report
+from gyrocal.thermal_report import markdown_table, write_report
 
 NOISE = np.radians(0.05)
 PROTO = {"step_duration": 3.0}

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from gyrocal.errors import FileFormatError, InputError, OutOfRangeError
-from gyrocal.models import correct
+from gyrocal.files import load_thermal, save_thermal
+from gyrocal.models import correct, kg_to_kb
 from gyrocal.recording import Recording
 from gyrocal.simulation.thermal_truth import ThermalTruth
 from gyrocal.thermal import (
@@ -16,8 +17,6 @@ from gyrocal.thermal import (
     fit_smooth,
     smooth_temperature,
 )
-from gyrocal.files import load_thermal, save_thermal
-from gyrocal.models import kg_to_kb
 
 TEMPS = np.array([-40.0, -30, -20, -10, 0, 10, 20, 30, 40, 50])
 TRUTH = ThermalTruth()

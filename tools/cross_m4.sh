@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Cross-compile the gyrocal C library for a Cortex-M4F, run the on-device calibration example under
 # qemu-system-arm (mps2-an386, semihosting) and print code size, peak stack use and executed instructions.
+# Then build the example firmware of examples/firmware (gyrocal frames, on-device six-turn session) with a
+# QEMU board layer, run it, and compare every byte it sends with the same firmware built for the host.
 #
 # Usage: tools/cross_m4.sh [BUILD_DIR]        (run by hand, not in CI; installs what it needs with apt-get)
 #
@@ -38,15 +40,17 @@ CFLAGS=(-std=c99 -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard -Os 
 echo "== toolchain: $(arm-none-eabi-gcc --version | head -1); $(qemu-system-arm --version | head -1)"
 echo "== flags: ${CFLAGS[*]}"
 
-arm-none-eabi-gcc "${CFLAGS[@]}" -I"$csrc" -c "$csrc/gyrocal_cal.c" -o "$build/gyrocal_cal.o"
+for unit in gyrocal_cal gyrocal_frame gyrocal_session; do
+    arm-none-eabi-gcc "${CFLAGS[@]}" -I"$csrc" -c "$csrc/$unit.c" -o "$build/$unit.o"
+done
 arm-none-eabi-gcc "${CFLAGS[@]}" -I"$csrc" -I"$m4" -c "$m4/main.c" -o "$build/main.o"
 # The start-up copies must not become calls to memcpy/memset: there is no libc.
 arm-none-eabi-gcc "${CFLAGS[@]}" -fno-tree-loop-distribute-patterns -I"$m4" -c "$m4/startup.c" -o "$build/startup.o"
 arm-none-eabi-gcc "${CFLAGS[@]}" -nostdlib -nostartfiles -T "$m4/mps2_an386.ld" -Wl,--gc-sections \
     "$build/startup.o" "$build/main.o" "$build/gyrocal_cal.o" -lgcc -o "$build/example.elf"
 
-echo "== code size of the library (calibration, correction, thermal table, accumulator), bytes:"
-arm-none-eabi-size "$build/gyrocal_cal.o"
+echo "== code size of the library (calibration, correction, thermal table, accumulator; frame encoder; session), bytes:"
+arm-none-eabi-size "$build/gyrocal_cal.o" "$build/gyrocal_frame.o" "$build/gyrocal_session.o"
 undefined="$(arm-none-eabi-nm -u "$build/gyrocal_cal.o" | tr -s ' \n' ' ')"
 echo "   undefined symbols (must be none): ${undefined:-none}"
 echo "== static RAM of an on-device calibration (the example's accumulator and six observations), bytes:"
@@ -106,4 +110,25 @@ counter=$!
 "${qemu[@]}" "${onebyone[@]}" -d exec,nochain -D "$fifo" >/dev/null 2>&1
 wait "$counter"
 rm -f "$fifo"
+echo "== the example firmware (examples/firmware) on the emulated M4: frames from the six-turn session"
+ex="$root/examples/firmware"
+arm-none-eabi-gcc "${CFLAGS[@]}" -I"$csrc" -I"$ex" -I"$m4" -c "$ex/gyrocal_example.c" -o "$build/gyrocal_example.o"
+arm-none-eabi-gcc "${CFLAGS[@]}" -I"$csrc" -I"$ex" -I"$m4" -c "$ex/qemu_board.c" -o "$build/qemu_board.o"
+arm-none-eabi-gcc "${CFLAGS[@]}" -nostdlib -nostartfiles -T "$m4/mps2_an386.ld" -Wl,--gc-sections \
+    "$build/startup.o" "$build/qemu_board.o" "$build/gyrocal_example.o" "$build/gyrocal_session.o" \
+    "$build/gyrocal_frame.o" "$build/gyrocal_cal.o" -lgcc -o "$build/firmware.elf"
+echo "   portable firmware (example loop + session + frames + library, no board layer), bytes:"
+arm-none-eabi-size "$build/gyrocal_example.o"
+echo "   whole image with the QEMU board layer and start-up (gc-sections), bytes:"
+arm-none-eabi-size "$build/firmware.elf"
+"${qemu[@]/example.elf/firmware.elf}" > "$build/firmware_m4.hex" 2>&1
+cc -std=c99 -O2 -DGYROCAL_HOST -I"$csrc" -I"$ex" -I"$m4" "$ex/qemu_board.c" "$ex/gyrocal_example.c" \
+    "$csrc/gyrocal_session.c" "$csrc/gyrocal_frame.c" "$csrc/gyrocal_cal.c" -lm -o "$build/firmware_host"
+"$build/firmware_host" > "$build/firmware_host.hex"
+echo "   frames sent: $(wc -l < "$build/firmware_m4.hex") (M4), $(wc -l < "$build/firmware_host.hex") (host)"
+if cmp -s "$build/firmware_m4.hex" "$build/firmware_host.hex"; then
+    echo "   identical: every byte the M4 sent equals the host build's"
+else
+    echo "   DIFFERENT: compare $build/firmware_m4.hex and $build/firmware_host.hex"
+fi
 echo "== build folder: $build"

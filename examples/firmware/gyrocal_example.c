@@ -32,7 +32,7 @@ void example_setup(example_t *ex, float sample_rate, float sensitivity, int has_
     hello.sensitivity = sensitivity;
     hello.rate_unit = GYROCAL_UNIT_DEG_S;
     hello.flags = has_temp ? GYROCAL_HELLO_HAS_TEMP : 0u;
-    hello.library = 0x0100u;
+    hello.library = GYROCAL_CAL_VERSION;
     for (i = 0; i < sizeof hello.firmware; ++i) {
         hello.firmware[i] = i < sizeof name - 1u ? name[i] : '\0';
     }

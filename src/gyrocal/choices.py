@@ -11,7 +11,10 @@ from typing import Literal, get_args
 
 __all__ = [
     "AccelUnit",
+    "CaptureWire",
     "DesignName",
+    "DeviceWire",
+    "GuideName",
     "InputUnit",
     "Method",
     "OutOfRange",
@@ -41,6 +44,12 @@ TableModel = Literal["lagrange", "smooth", "traditional"]
 Protocol = Literal["servo", "hand", "turntable", "profile"]
 #: Monte Carlo studies reproducing the papers (see :mod:`gyrocal.studies`).
 StudyName = Literal["servo-normal", "servo-extreme", "servo-speed", "servo-convergence", "thermal-compare"]
+#: Wire formats ``gyrocal capture`` reads ("auto": whichever decodes first; see :mod:`gyrocal.capture`).
+CaptureWire = Literal["auto", "frames", "text"]
+#: Wire formats the virtual device sends (``gyrocal simulate --device``).
+DeviceWire = Literal["frames", "text"]
+#: Guided sessions of ``gyrocal capture --guide`` (see :mod:`gyrocal.capture.guide`).
+GuideName = Literal["servo", "hand"]
 #: Experimental designs of the planner (see :mod:`gyrocal.planning`).
 DesignName = Literal["six", "six-static", "twelve"]
 

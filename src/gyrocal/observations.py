@@ -53,6 +53,13 @@ class Observation:
         Reference mean rate magnitude [rad/s]; 0 for static windows.
     angle : float
         Angle turned inside the window [rad]; NaN unless ``kind == "angle"``.
+    mean_var : ndarray, shape (3,), or None
+        Variance of the window mean [reading units^2] when it was measured on the window itself
+        (long-run variance: correlated noise, speed ripple); None to take white noise,
+        ``sigma^2 / count``, with sigma pooled over the windows by the estimator.
+    rate_var : float
+        Variance of the reference `rate` [rad^2/s^2]: zero for a declared speed or an exact
+        angle; a turn with a gap in its time stamps has an angle known only within a bound.
     """
 
     mean: np.ndarray
@@ -63,9 +70,13 @@ class Observation:
     kind: ReferenceKind
     rate: float
     angle: float = math.nan
+    mean_var: np.ndarray | None = None
+    rate_var: float = 0.0
 
     def __post_init__(self):
-        for name in ("mean", "mean_sq", "noise_var"):
+        if not (math.isfinite(self.rate_var) and self.rate_var >= 0):
+            raise InputError(f"rate_var must be finite and >= 0, got {self.rate_var!r}")
+        for name in ("mean", "mean_sq", "noise_var") + (("mean_var",) if self.mean_var is not None else ()):
             arr = finite_array(name, getattr(self, name), shape_tail=(3,), ndim=1)
             object.__setattr__(self, name, readonly(arr, copy=True))
         if self.kind not in _KINDS:
@@ -170,7 +181,10 @@ class ObservationSet:
     Shapes use ``n`` for windows and an optional leading batch axis ``B``:
     ``mean``, ``mean_sq``, ``noise_var`` are (n, 3) or (B, n, 3); ``rate`` is (n,)
     or (B, n); ``count``, ``duration`` and ``static`` are (n,) and shared by the batch
-    (one design). Reference rates are in rad/s.
+    (one design). Reference rates are in rad/s. ``mean_var`` (optional, the shape of
+    ``mean``) holds each window mean's own variance [reading units^2], NaN where the
+    estimator is to use pooled white noise (see :class:`Observation`); ``rate_var``
+    (optional, (n,)) the variance of each reference rate [rad^2/s^2].
     """
 
     mean: np.ndarray
@@ -180,6 +194,8 @@ class ObservationSet:
     count: np.ndarray
     duration: np.ndarray
     static: np.ndarray
+    mean_var: np.ndarray | None = None
+    rate_var: np.ndarray | None = None
 
     def __post_init__(self):
         mean = finite_array("mean", self.mean, shape_tail=(3,))
@@ -202,6 +218,16 @@ class ObservationSet:
         static = np.asarray(self.static, dtype=bool)
         if static.shape != (n,):
             raise InputError(f"static must be {n} flags, got shape {static.shape}")
+        if self.mean_var is not None:
+            mv = np.asarray(self.mean_var, dtype=float)
+            if mv.shape != mean.shape or np.any(mv[np.isfinite(mv)] < 0) or np.any(np.isinf(mv)):
+                raise InputError(f"mean_var must be >= 0 (or NaN) with the shape of mean {mean.shape}, got {mv.shape}")
+            object.__setattr__(self, "mean_var", mv)
+        if self.rate_var is not None:
+            rv = finite_array("rate_var", self.rate_var, ndim=1)
+            if rv.shape != (n,) or np.any(rv < 0):
+                raise InputError(f"rate_var must be {n} values >= 0, got shape {rv.shape}")
+            object.__setattr__(self, "rate_var", rv)
         object.__setattr__(self, "mean", mean)
         object.__setattr__(self, "rate", np.broadcast_to(rate, mean.shape[:-1]) if rate.ndim == 1 else rate)
         object.__setattr__(self, "static", static)
@@ -220,6 +246,9 @@ class ObservationSet:
             count=np.array([o.count for o in obs], dtype=float),
             duration=np.array([o.duration for o in obs]),
             static=np.array([o.kind == "static" for o in obs]),
+            mean_var=None if all(o.mean_var is None for o in obs) else np.stack(
+                [np.full(3, np.nan) if o.mean_var is None else o.mean_var for o in obs]),
+            rate_var=None if all(o.rate_var == 0 for o in obs) else np.array([o.rate_var for o in obs]),
         )
 
     @property
@@ -231,14 +260,16 @@ class ObservationSet:
         if self.batched:
             return self
         return ObservationSet(self.mean[None], self.mean_sq[None], self.noise_var[None], self.rate[None],
-                              self.count, self.duration, self.static)
+                              self.count, self.duration, self.static,
+                              None if self.mean_var is None else self.mean_var[None], self.rate_var)
 
     def take(self, index) -> ObservationSet:
         """The gyros at `index` (a slice, an int array or a boolean mask), still batched."""
         b = self.as_batch()
         idx = index if isinstance(index, slice) else np.asarray(index)
         return ObservationSet(b.mean[idx], b.mean_sq[idx], b.noise_var[idx], b.rate[idx],
-                              self.count, self.duration, self.static)
+                              self.count, self.duration, self.static,
+                              None if b.mean_var is None else b.mean_var[idx], self.rate_var)
 
     @property
     def batch_size(self) -> int:

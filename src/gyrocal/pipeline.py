@@ -2,8 +2,8 @@
 
 ``calibrate`` is what the ``gyrocal calibrate`` command runs. With a known speed the
 rotation windows are the constant-speed plateaus and their reference is the speed; with
-a known angle they are whole turns and their reference is ``angle / duration`` (SPEC,
-Method S, first-moment form). A windows file overrides detection.
+a known angle they are whole turns and their reference is ``angle / duration`` (docs/core.md,
+Estimators, first-moment form). A windows file overrides detection.
 
 Which windows each method uses:
 
@@ -24,15 +24,20 @@ import numpy as np
 
 from .calibration import Calibration
 from .errors import InputError
-from .estimators import FitResult, make_estimator
-from .observations import Observation, ObservationSet, observe
+from .estimators import FitResult, make_estimator, window_residuals
+from .observations import Observation, ObservationSet
+from .observed import quiet_noise
+from .plausibility import Context, check_plausibility
+from .quality import GoodnessOfFit, assess_fit
 from .recording import Recording
-from .segmentation import Segmentation, segment
-from .segmentation._motion import static_level
+from .screening import require_constant_rate, screen_gaps
+from .segmentation import Segmentation, segment, standstill_level
+from .timebase import TimeBase
 from .units import parse_input_unit, parse_rate_unit, unit_factor
+from .window_stats import observe_window, pool_static_variance
 from .windows import Window
 
-__all__ = ["CalibrationRun", "calibrate"]
+__all__ = ["CalibrationRun", "calibrate", "parameter_rows"]
 
 
 @dataclass(frozen=True)
@@ -52,6 +57,16 @@ class CalibrationRun:
     reference : {"speed", "angle"}
     reference_value : float
         The known speed [rad/s] or angle per turn [rad].
+    quality : GoodnessOfFit or None
+        Goodness of fit (residuals per window in noise units, chi2/dof, p-value, Birge scaling);
+        None when the self-checks were off.
+    time_base : TimeBase or None
+        Facts about the time stamps (rate, jitter, late deliveries, gaps); None when the
+        self-checks were off.
+    warnings : tuple of str
+        What the self-checks found wrong or doubtful (fit quality, plausibility of k).
+    notes : tuple of str
+        What they found worth saying (the sensitivity counts imply).
     """
 
     calibration: Calibration
@@ -60,23 +75,17 @@ class CalibrationRun:
     observations: tuple[Observation, ...]
     reference: str
     reference_value: float
+    quality: GoodnessOfFit | None = None
+    time_base: TimeBase | None = None
+    warnings: tuple[str, ...] = ()
+    notes: tuple[str, ...] = ()
 
     def parameters(self) -> list[tuple[str, float, float, str]]:
-        """``(name, value, 1-sigma, unit)`` of k and b in user units (sigma NaN if unknown)."""
-        cal = self.calibration
-        c, d = cal.input_scale, unit_factor(cal.output_units)
-        p = cal.model.params
-        std = cal.std if cal.std is not None else np.full(len(p), np.nan)
-        k_unit = "1" if cal.input_units == cal.output_units else f"{cal.output_units} per {cal.input_units}"
-        rows = []
-        for j, axis in enumerate("xyz"):
-            rows.append((f"k{axis}", p[j] * c / d, std[j] * c / d, k_unit))
-        for j, axis in enumerate("xyz"):
-            rows.append((f"b{axis}", p[3 + j] / c, std[3 + j] / c, cal.input_units))
-        return rows
+        """``(name, value, 1-sigma, unit)`` of k and b in user units (see :func:`parameter_rows`)."""
+        return parameter_rows(self.calibration)
 
     def scale_bias_note(self) -> str | None:
-        """For the paper's mean-of-squares methods, how low they read k (SPEC); None otherwise."""
+        """For the paper's mean-of-squares methods, how low they read k (docs/core.md, Accuracy); None otherwise."""
         fit = self.fit
         if self.calibration.method == "first-moment" or fit.noise_std is None:
             return None
@@ -113,10 +122,7 @@ class CalibrationRun:
 
 
 def _baseline(rec: Recording, windows: Sequence[Window]) -> np.ndarray:
-    statics = [w for w in windows if w.kind == "static"]
-    if statics:
-        return np.mean(np.concatenate([rec.gyro[w.start:w.stop] for w in statics]), axis=0)
-    return static_level(rec.gyro, max(8, int(round(0.25 * rec.sample_rate))))[0]
+    return standstill_level(rec, windows)
 
 
 #: A given window's first or last tenth may turn this much slower than its middle (--speed only).
@@ -171,29 +177,26 @@ def _given_windows(rec: Recording, windows: Sequence[Window], reference: str, sp
     return Segmentation(tuple(out), (), "file", fs, base, noise)
 
 
-def _gap_times(rec: Recording, w: Window) -> np.ndarray | None:
-    """The window's sample times when the log dropped samples inside it, else None (evenly spaced).
+def parameter_rows(cal: Calibration) -> list[tuple[str, float, float, str]]:
+    """``(name, value, 1-sigma, unit)`` of k and b (Wang et al., eq. 1) in user units (sigma NaN if unknown).
 
-    Without a time column ``t`` is still exact: rows dropped for saturation leave their gaps in it.
+    k and b are what the file stores (``parameters``), in the user's units: with counts and a
+    sensitivity, k is relative to that sensitivity (1 = as declared) and b is in the output unit,
+    as the counts were converted before the fit; with counts alone, k absorbs the sensitivity
+    (output unit per count) and b is in counts.
     """
-    if len(w) < 2:
-        return None
-    t = rec.t[w.start:w.stop]
-    return t if (t[-1] - t[0]) * rec.sample_rate > len(w) - 0.5 else None
-
-
-def _observe(rec: Recording, w: Window, reference: str, speed) -> Observation:
-    # Column-major windows make the per-axis reductions contiguous (about 4x faster than C order):
-    # readers give column-major recordings; others are copied window by window, not whole.
-    samples = rec.gyro[w.start:w.stop]
-    if not rec.gyro.flags.f_contiguous:
-        samples = np.asfortranarray(samples)
-    fs = rec.sample_rate
-    if w.kind == "static":
-        return observe(samples, fs, "static")
-    if reference == "speed":
-        return observe(samples, fs, "speed", speed=speed)
-    return observe(samples, fs, "angle", angle=w.angle, t=_gap_times(rec, w))
+    p = cal.model.params
+    std = cal.std if cal.std is not None else np.full(len(p), np.nan)
+    d = unit_factor(cal.output_units)
+    if cal.input_units == "counts" and cal.sensitivity is not None:
+        k_scale, b_scale, k_unit, b_unit = 1.0, 1.0 / d, "1", cal.output_units
+    else:
+        c = cal.input_scale
+        k_scale, b_scale, b_unit = c / d, 1.0 / c, cal.input_units
+        per = "count" if cal.input_units == "counts" else cal.input_units
+        k_unit = "1" if cal.input_units == cal.output_units else f"{cal.output_units} per {per}"
+    rows = [(f"k{axis}", p[j] * k_scale, std[j] * k_scale, k_unit) for j, axis in enumerate("xyz")]
+    return rows + [(f"b{axis}", p[3 + j] * b_scale, std[3 + j] * b_scale, b_unit) for j, axis in enumerate("xyz")]
 
 
 def calibrate(
@@ -205,6 +208,7 @@ def calibrate(
     windows: Sequence[Window] | None = None,
     noise_std=None,
     output_units: str | None = None,
+    checks: bool = True,
 ) -> CalibrationRun:
     """Calibrate a gyro from one recording of a servo, gimbal, robot or hand session.
 
@@ -223,16 +227,25 @@ def calibrate(
         Windows from a windows file; they override detection. Rotation windows without
         an angle of their own use `angle`.
     noise_std : float or array_like of shape (3,), optional
-        Known per-sample noise [internal units: rad/s, or counts]; first-moment only.
+        Known per-sample noise [internal units: rad/s, or counts], > 0; first-moment only.
         Estimated from the windows when omitted.
     output_units : {"rad/s", "deg/s"}, optional
         Unit of corrected rates; default the recording's unit, or deg/s for counts. For
         counts with a sensitivity it must be the unit the sensitivity refers to.
+    checks : bool
+        Run the self-checks (default): the sensor clock rebuilt under the time stamps and turns
+        across real gaps bounded or left out, plateau levels with their speed ripple regressed
+        out and each window mean's own long-run variance, the paper's methods refusing varying
+        rates, goodness of fit with Birge scaling of the covariance, plausibility of k.
+        ``False`` gives the plain estimate on the stamps as they are (benchmarks and tests
+        compare the two).
 
     Raises
     ------
     SegmentationError
         When the windows the method needs are not there; the message lists what was found.
+    InputError
+        For Algorithm 1 and LM, a rotation window whose rate varies (ramps, hand turns).
     """
     if (speed is None) == (angle is None):
         raise InputError(f"give exactly one of speed [rad/s] or angle [rad], got speed={speed!r}, angle={angle!r}")
@@ -242,6 +255,10 @@ def calibrate(
         raise InputError(f"{reference} must be a finite non-zero number, got {value!r}")
     if noise_std is not None and method != "first-moment":
         raise InputError(f"noise_std applies to method 'first-moment' only, got method={method!r}")
+    if noise_std is not None and not np.all(np.asarray(noise_std, dtype=float) > 0):
+        raise InputError(f"{{param}} must be > 0 on every axis, got {noise_std!r}: a zero noise would give a zero "
+                         "1-sigma", param="noise_std", value=noise_std,
+                         hint="measure it (gyrocal noise) or leave {param} out to estimate it from the windows")
     estimator = make_estimator(method, **({} if noise_std is None else {"noise_std": noise_std}))
     input_units = parse_input_unit(rec.source_units, "recording source_units")
     out_units = parse_rate_unit(output_units or ("deg/s" if input_units == "counts" else input_units), "output_units")
@@ -250,11 +267,35 @@ def calibrate(
     else:
         seg = _given_windows(rec, windows, reference, value if reference == "speed" else None,
                              value if reference == "angle" else None)
+    tb = rec.time_base() if checks else None
+    angle_var: dict = {}
+    times = None if tb is None else tb.clock_times()  # the sensor's clock under receive-time stamps
+    if tb is not None:
+        seg, angle_var = screen_gaps(seg, rec, tb, reference, times)
     uses_static = method == "first-moment"
     seg.require(static_allowed=uses_static, min_rotations=0 if uses_static else 6)
     used = seg.windows if uses_static else seg.rotations
-    observations = tuple(_observe(rec, w, reference, value) for w in used)
-    fit = estimator.fit(ObservationSet.from_observations(observations))
+    if checks and not uses_static:
+        require_constant_rate(rec, used, seg.baseline, method)
+    observations = tuple(observe_window(rec, w, reference, value, long_run=checks and noise_std is None,
+                                        ripple=uses_static and checks, times=times) for w in used)
+    observations = pool_static_variance(observations)
+    if angle_var:  # turns across a time-stamp gap: their rate is known within the gap's bound
+        observations = tuple(dataclasses.replace(o, rate_var=angle_var[(w.start, w.stop)] * o.rate**2)
+                             if (w.start, w.stop) in angle_var else o for w, o in zip(used, observations))
+    obs_set = ObservationSet.from_observations(observations)
+    fit = estimator.fit(obs_set)
+    quality, warnings, notes = None, [], []
+    if checks:
+        quality = assess_fit(window_residuals(fit, obs_set), [_label(w) for w in used], len(fit.model.params),
+                             what="the turns and static windows" if uses_static else "the turns")
+        if quality.covariance_scaled and fit.covariance is not None:
+            fit = dataclasses.replace(fit, covariance=fit.covariance * quality.birge_ratio**2)
+        ctx = Context(units=input_units, counts_scale=rec.units == "counts", reference=reference,
+                      declared=value if windows is None or reference == "speed" else math.nan,
+                      sample_rate=rec.sample_rate, has_time=rec.has_time, sensitivity=rec.sensitivity)
+        plausible, notes = check_plausibility(fit.model.k, ctx)
+        warnings = list(quality.warnings) + plausible
     cal = Calibration(
         model=fit.model,
         input_units=input_units,
@@ -264,5 +305,27 @@ def calibrate(
         covariance=fit.covariance,
         noise_std=fit.noise_std,
         windows=tuple({**w.to_dict(), "rate": o.rate} for w, o in zip(used, observations)),
+        fit=None if quality is None else quality.to_document(),
     )
-    return CalibrationRun(cal, fit, seg, observations, reference, value)
+    if tb is not None:
+        cal = dataclasses.replace(cal, observed=_observed(rec, tb, fit.noise_std, cal.input_scale, input_units))
+    return CalibrationRun(cal, fit, seg, observations, reference, value, quality, tb, tuple(warnings), tuple(notes))
+
+
+def _observed(rec: Recording, tb: TimeBase, noise_std, input_scale: float, input_units: str) -> dict:
+    """What the calibration saw (the file's ``observed`` section), rates in the input units.
+
+    `input_scale` is internal units per input unit (:attr:`gyrocal.calibration.Calibration.input_scale`).
+    """
+    peak = np.maximum(rec.gyro.max(axis=0), -rec.gyro.min(axis=0))
+    return {"sample_rate": rec.sample_rate, "units": input_units,
+            "noise_std": (np.asarray(noise_std, dtype=float) / input_scale).tolist(),
+            "max_abs_rate": (peak / input_scale).tolist(), "time_base": tb.to_document(),
+            # the noise of the quiet stretches, measured as apply measures the data it corrects
+            "quiet_noise_std": quiet_noise(rec.gyro / input_scale, rec.sample_rate).tolist()}
+
+
+def _label(w: Window) -> str:
+    if w.kind == "static":
+        return "static"
+    return w.label or (f"{'+' if w.sign >= 0 else '-'}{w.axis}" if w.axis else "rotation")

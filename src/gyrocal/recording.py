@@ -8,9 +8,10 @@ from typing import Literal
 import numpy as np
 
 from ._arrays import readonly
-from .choices import AccelUnit, values
 from ._validation import finite_array, positive
+from .choices import AccelUnit, values
 from .errors import InputError
+from .timebase import TimeBase, analyse_time, nominal_period
 
 __all__ = ["Recording"]
 
@@ -33,7 +34,8 @@ class Recording:
     source_units : str
         Unit the data were declared in (``rad/s``, ``deg/s`` or ``counts``), for output.
     sample_rate : float
-        Nominal sampling rate [Hz] (given, or the median of the time steps).
+        Nominal sampling rate [Hz]: given, or the mean rate of the sensor clock measured on the
+        stamps (:func:`gyrocal.timebase.nominal_period`), never the median of bursty steps.
     has_time : bool
         Whether ``t`` came from the data (False: built from ``sample_rate``).
     temp : ndarray, shape (N,), or None
@@ -84,7 +86,7 @@ class Recording:
             raise InputError(f"time does not increase at sample {i + 1} (t={t[i]} then {t[i + 1]}); sort or deduplicate the log")
         if self.units not in ("rad/s", "counts"):
             raise InputError(f"units must be 'rad/s' or 'counts' inside gyrocal, got {self.units!r}")
-        fs = self.sample_rate or (1.0 / float(np.median(np.diff(t))) if n >= 2 else 0.0)
+        fs = self.sample_rate or (1.0 / nominal_period(t) if n >= 2 else 0.0)
         object.__setattr__(self, "sample_rate", positive("sample_rate", fs))
         object.__setattr__(self, "t", readonly(t, None, copy=False))
         object.__setattr__(self, "gyro", readonly(gyro, None, copy=False))
@@ -133,6 +135,10 @@ class Recording:
         g = np.asarray(gyro, dtype=float)
         fs = positive("sample_rate", sample_rate)
         return cls(t=t0 + np.arange(len(g)) / fs, gyro=g, sample_rate=fs, has_time=False, **kwargs)
+
+    def time_base(self) -> TimeBase:
+        """Facts about the time stamps: nominal rate, jitter, late deliveries and real gaps."""
+        return analyse_time(self.t, has_time=self.has_time)
 
     def slice(self, start: int, stop: int) -> np.ndarray:
         """Readings of samples ``start:stop`` (N, 3)."""

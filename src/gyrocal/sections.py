@@ -173,29 +173,44 @@ class Section(Mapping):
         return cls(frozen)
 
 
-class FitQuality(Section):
-    """How well the model fits the data (``fit`` section).
+def _residuals(v):
+    """Residuals in noise units: numbers, or one ``{"window", "label", "z": [numbers]}`` object per window."""
+    if isinstance(v, tuple) and all(isinstance(r, Mapping) for r in v):
+        for r in v:
+            numbers((-1,))(r.get("z", ()))
+        return v
+    return numbers((-1,))(v)
 
-    Documented keys: ``chi2``, ``dof``, ``p_value``, ``birge_ratio`` (sqrt(chi2 / dof)),
-    ``covariance_scaled`` (whether the covariance was scaled by chi2 / dof),
-    ``residuals`` (per window, in noise units), ``warnings`` (list of text).
+
+class FitQuality(Section):
+    """How well the model fits the data (``fit`` section; :class:`gyrocal.quality.GoodnessOfFit` writes it).
+
+    Documented keys: ``chi2``, ``dof`` (0: no residual degrees of freedom, nothing checked),
+    ``chi2_per_dof``, ``p_value`` (null without dof), ``birge_ratio`` (sqrt(chi2 / dof)),
+    ``covariance_scaled`` (whether ``covariance`` and ``std`` were scaled by chi2 / dof, as when
+    p < 0.001), ``residuals`` (per window in noise units: ``{"window", "label", "z"}``, one ``z``
+    for a turn, three for a static window), ``disagree`` (the windows that disagree most, when
+    flagged), ``warnings`` (list of text).
     """
 
     NAME = "fit"
-    FIELDS = {"chi2": number(0), "dof": integer(0), "p_value": number(0, 1), "birge_ratio": number(0),
-              "covariance_scaled": boolean, "residuals": numbers((-1,)), "warnings": texts}
+    FIELDS = {"chi2": number(0), "dof": integer(0), "chi2_per_dof": number(0), "p_value": number(0, 1),
+              "birge_ratio": number(0), "covariance_scaled": boolean, "residuals": _residuals,
+              "disagree": numbers((-1,), 0), "warnings": texts}
 
 
 class Observed(Section):
     """What the calibration data looked like (``observed`` section), used to catch unit mistakes later.
 
     Documented keys: ``sample_rate`` [Hz], ``noise_std`` per axis and ``max_abs_rate`` per axis
-    [input units], ``units`` (the input unit they are in).
+    [input units], ``units`` (the input unit they are in), ``time_base`` (``nominal_rate`` [Hz],
+    ``has_time``, ``mean_step``, ``median_step``, ``jitter`` [s], ``late_deliveries``, ``gaps``,
+    ``lost_samples``, ``regular_clock``: :meth:`gyrocal.timebase.TimeBase.to_document`).
     """
 
     NAME = "observed"
     FIELDS = {"sample_rate": number(0), "noise_std": numbers((3,), 0), "max_abs_rate": numbers((3,), 0),
-              "units": text}
+              "units": text, "time_base": obj}
 
 
 class AccelerometerPart(Section):

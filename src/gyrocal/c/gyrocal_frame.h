@@ -60,7 +60,7 @@ typedef struct {
     float sensitivity;  /* counts per rate unit (LSB per deg/s for deg/s) */
     uint8_t rate_unit;  /* GYROCAL_UNIT_* */
     uint8_t flags;      /* GYROCAL_HELLO_* */
-    uint16_t library;   /* gyrocal C library version, major << 8 | minor */
+    uint16_t library;   /* GYROCAL_CAL_VERSION of the gyrocal C library the firmware was built with */
     char firmware[16];  /* firmware name and version, NUL-padded (need not be terminated) */
 } gyrocal_hello_t;
 

@@ -13,7 +13,7 @@ import ctypes
 
 import numpy as np
 
-from ..firmware import CLibrary, load_library
+from ..firmware import C_LIBRARY_VERSION, CLibrary, load_library
 from .frames import TURN_LABELS
 
 __all__ = ["CDevice", "firmware_stream"]
@@ -98,7 +98,7 @@ class CDevice:
         return self.dll.gyrocal_crc16(arr, len(data), 0xFFFF)
 
     def hello(self, sample_rate: float, sensitivity: float, *, has_temp: bool, firmware: str,
-              library: int = 0x0100, rate_unit: int = 1) -> bytes:
+              library: int = C_LIBRARY_VERSION, rate_unit: int = 1) -> bytes:
         h = _Hello(sample_rate, sensitivity, rate_unit, int(has_temp), library, firmware.encode()[:16])
         return self._out(self.dll.gyrocal_frame_hello(self._buf, ctypes.byref(h)))
 

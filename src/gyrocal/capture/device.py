@@ -28,7 +28,7 @@ from ..errors import InputError
 from .frames import Hello, encode, encode_samples
 from .simulated import DeviceSession
 
-__all__ = ["Faults", "VirtualDevice", "damage", "device_bytes", "text_lines"]
+__all__ = ["Faults", "VirtualDevice", "damage", "device_bytes", "parse_faults", "text_lines"]
 
 Wire = Literal["frames", "text"]
 
@@ -64,9 +64,31 @@ class Faults:
         for name in ("drop", "corrupt", "stall_at", "disconnect_at"):
             v = getattr(self, name)
             if v is not None and not 0 <= v <= 1:
-                raise InputError(f"{name} must be a fraction in [0, 1], got {v!r}")
+                raise InputError(f"the {name} fault must be a fraction in [0, 1], got {v!r}", param="faults", value=v)
         if not self.stall_s >= 0:
-            raise InputError(f"stall_s must be >= 0 s, got {self.stall_s!r}")
+            raise InputError(f"a stall must last >= 0 s, got {self.stall_s!r}", param="faults", value=self.stall_s)
+
+
+def parse_faults(spec: str | None, seed: int = 0) -> Faults:
+    """Faults from ``"drop=1e-4,corrupt=1e-4,stall=0.5:2,disconnect=0.8"`` (the ``--faults`` syntax)."""
+    kw: dict = {"seed": seed}
+    for item in filter(None, (p.strip() for p in (spec or "").split(","))):
+        key, _, value = item.partition("=")
+        try:
+            if key == "stall":
+                at, _, secs = value.partition(":")
+                kw["stall_at"], kw["stall_s"] = float(at), float(secs or 2.0)
+            elif key in ("drop", "corrupt"):
+                kw[key] = float(value)
+            elif key == "disconnect":
+                kw["disconnect_at"] = float(value)
+            else:
+                raise ValueError(key)
+        except ValueError:
+            raise InputError(f"{{param}} entry {item!r} is not understood", param="faults", value=spec,
+                             hint="write e.g. {param} drop=1e-4,corrupt=1e-4,stall=0.5:2,disconnect=0.8 (drop and "
+                                  "corrupt per byte; stall and disconnect where, as a fraction of the stream)") from None
+    return Faults(**kw)
 
 
 @dataclass(frozen=True)
@@ -109,7 +131,7 @@ def device_bytes(session: DeviceSession, wire: Wire = "frames", encoder: Literal
     if wire == "text":
         return text_lines(session)
     if wire != "frames":
-        raise InputError(f"wire must be 'frames' or 'text', got {wire!r}")
+        raise InputError(f"{{param}} must be 'frames' or 'text', got {wire!r}", param="wire", value=wire)
     if encoder == "c":
         from .c_device import firmware_stream
 
@@ -254,7 +276,7 @@ class VirtualDevice:
         buf = fcntl.ioctl(self._slave, termios.FIONREAD, struct.pack("i", 0))
         return struct.unpack("i", buf)[0]
 
-    def _drain(self, quiet: float = 0.25) -> None:
+    def _drain(self, quiet: float = 0.5) -> None:
         """Wait until the reader has taken every byte sent: closing a pty discards unread input.
 
         The kernel hands written bytes to the reader's queue a little later (a work queue), so the

@@ -72,7 +72,7 @@ class Hello:
     sensitivity: float
     rate_unit: str = "deg/s"
     has_temp: bool = False
-    library: int = 0x0100
+    library: int = 2  # GYROCAL_CAL_VERSION
     firmware: str = ""
     protocol: int = PROTOCOL
 

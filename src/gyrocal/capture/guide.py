@@ -30,6 +30,9 @@ from ..windows import Window
 
 __all__ = ["GUIDES", "Guide", "GuideEvent", "Step"]
 
+#: Scale factors a guided turn may imply: its measured size within 25 % of the asked one.
+_GUIDE_K_RANGE = (0.8, 1 / 0.75)
+
 
 @dataclass(frozen=True)
 class Step:
@@ -90,7 +93,7 @@ class Guide:
 
     def __init__(self, name: str, *, speed: float | None = None, angle: float = 2 * math.pi, settle: float = 1.0):
         if name not in GUIDES:
-            raise InputError(f"guide must be one of {', '.join(GUIDES)}, got {name!r}")
+            raise InputError(f"{{param}} must be one of {', '.join(GUIDES)}, got {name!r}", param="guide", value=name)
         self.name, self.steps = name, GUIDES[name]
         self.speed, self.angle, self.settle = speed, angle, settle
         self.index = 0
@@ -124,17 +127,30 @@ class Guide:
         return [GuideEvent("redo", self.index, f"redo step {self.index + 1}"), self._prompt()]
 
     def update(self, rec: Recording, every: float = 0.25) -> list[GuideEvent]:
-        """Judge the current step on the recording so far (rad/s, or counts with a sensitivity)."""
-        n, fs = len(rec), rec.sample_rate
+        """Judge the current step on the recording so far (rad/s, or counts with a sensitivity).
+
+        Steps are judged at fixed points of the data (every `every` seconds of samples), so the
+        outcome does not depend on how the samples arrived in chunks.
+        """
+        fs = rec.sample_rate
+        stride = max(1, round(every * fs))
+        events: list[GuideEvent] = []
+        while not self.complete and self._checked + stride <= len(rec):
+            self._checked += stride
+            events += self._judge(rec, self._checked)
+        return events
+
+    def _judge(self, rec: Recording, n: int) -> list[GuideEvent]:
+        fs = rec.sample_rate
         # segmentation needs about a second of data to find the standstill level
-        if self.complete or n - self._checked < every * fs or n - self.since < max(1.0, self.settle) * fs:
+        if n - self.since < max(1.0, self.settle) * fs:
             return []
-        self._checked = n
-        sub = Recording(t=rec.t[self.since:], gyro=rec.gyro[self.since:], units=rec.units,
+        sub = Recording(t=rec.t[self.since:n], gyro=rec.gyro[self.since:n], units=rec.units,
                         source_units=rec.source_units, sample_rate=fs, sensitivity=rec.sensitivity)
         step = self.steps[self.index]
         ref = {"reference": "speed", "speed": self.speed} if self.speed else {"reference": "angle", "angle": self.angle}
-        seg = segment(sub, require=False, **ref)
+        # a guided turn must be the asked one within 25 %: a tighter scale range than calibration's 0.45-2.2
+        seg = segment(sub, require=False, k_range=_GUIDE_K_RANGE, **ref)
         motions = sorted([*seg.rotations, *(w for w, _ in seg.ignored if w.kind == "rotation")], key=lambda w: w.stop)
         return self._judge_still(seg, n, fs, motions) if step.kind == "still" else self._judge_turn(seg, n, fs, motions)
 

@@ -38,8 +38,9 @@ def open_port(port: str, baud: int, timeout: float = 0.1):
     try:
         return serial.serial_for_url(port, baudrate=int(baud), timeout=timeout)
     except (serial.SerialException, ValueError, OSError) as exc:
-        raise LinkError(f"cannot open {port!r}: {exc}; check the port name (ls /dev/ttyUSB* /dev/ttyACM*) and that no "
-                        "other program (a serial monitor) holds it") from None
+        raise LinkError(f"cannot open {port!r}: {exc}", param="port", value=port,
+                        hint="check {param} (ls /dev/ttyUSB* /dev/ttyACM*) and that no other program (a serial "
+                             "monitor) holds the port") from None
 
 
 @dataclass
@@ -95,10 +96,10 @@ class Capture:
                  stall: float = 1.0, on_event: Callable[[str, Any], None] | None = None,
                  header_comment: Callable[[], str] | None = None):
         if wire not in ("auto", "frames", "text"):
-            raise InputError(f"wire must be 'auto', 'frames' or 'text', got {wire!r}")
+            raise InputError(f"{{param}} must be 'auto', 'frames' or 'text', got {wire!r}", param="wire", value=wire)
         for name, v in (("duration", duration), ("samples", samples), ("silence", silence)):
             if v is not None and not v > 0:
-                raise InputError(f"{name} must be > 0 when given, got {v!r}")
+                raise InputError(f"{{param}} must be > 0 when given, got {v!r}", param=name, value=v)
         self.port, self.baud, self.wire = port, baud, wire
         self.duration, self.max_samples, self.silence, self.stall = duration, samples, silence, stall
         self.on_event = on_event or (lambda kind, payload: None)

@@ -20,7 +20,7 @@ def _rate(store) -> float | None:
     """Samples per second of device time over the last 2 s (None without time stamps)."""
     if not store.has_time or len(store) < 2:
         return None
-    t = store.t[-2000:]
+    t = store.t[-4000:]
     recent = t[t >= t[-1] - 2.0]
     return (len(recent) - 1) / (recent[-1] - recent[0]) if len(recent) > 1 and recent[-1] > recent[0] else None
 

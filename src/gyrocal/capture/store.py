@@ -22,6 +22,28 @@ def _cell(x: float) -> str:
     return str(int(x)) if float(x).is_integer() and abs(x) < 1e15 else repr(float(x))
 
 
+class _Column:
+    """A growable array: appends in amortised constant time, views without copying."""
+
+    def __init__(self, dtype, width: int = 0):
+        self._shape = (width,) if width else ()
+        self._a = np.empty((1024, *self._shape), dtype=dtype)
+        self.n = 0
+
+    def append(self, value) -> None:
+        if self.n == len(self._a):
+            self._a = np.concatenate([self._a, np.empty_like(self._a)])
+        self._a[self.n] = value
+        self.n += 1
+
+    def last(self):
+        return self._a[self.n - 1]
+
+    @property
+    def view(self) -> np.ndarray:
+        return self._a[: self.n]
+
+
 class SampleStore:
     """Samples received so far, and the file they go to.
 
@@ -37,35 +59,36 @@ class SampleStore:
         self.path = Path(path)
         self._comment = header_comment
         self._writer: IncrementalCSV | None = None
-        self._t: list[float] = []
-        self._g: list[tuple[float, float, float]] = []
-        self._temp: list[float] = []
-        self._seq: list[int] = []
+        self._t = _Column(float)
+        self._g = _Column(float, 3)
+        self._temp = _Column(float)
+        self._seq = _Column(np.int64)
         self.has_time = self.has_temp = False
         self.out_of_order = 0
         self.t0: float | None = None
         self._pending: list[list[str]] = []
 
     def __len__(self) -> int:
-        return len(self._g)
+        return self._g.n
 
     def add(self, t: float | None, g, temp: float | None, seq: int | None = None) -> None:
         """One sample: ``t`` [s] on the device's clock or None, ``g`` as received, ``temp`` [degC] or None."""
         if self._writer is None:
             self._open(t is not None, temp is not None)
+        row = []
         if self.has_time:
             if self.t0 is None and t is not None:
                 self.t0 = t
-            if t is None or (self._t and t - self.t0 <= self._t[-1]):
+            if t is None or (self._t.n and t - self.t0 <= self._t.last()):
                 self.out_of_order += 1
                 return
             self._t.append(t - self.t0)
+            row.append(f"{t - self.t0:.6f}")  # device clocks tick in microseconds
         if self.has_temp:
-            temp = self._temp[-1] if temp is None else temp  # a lost reading keeps the last one
+            temp = float(self._temp.last()) if temp is None else temp  # a lost reading keeps the last one
             self._temp.append(temp)
-        self._g.append(tuple(g))
-        self._seq.append(len(self._seq) if seq is None else seq)
-        row = [f"{self._t[-1]:.6f}"] if self.has_time else []  # device clocks tick in microseconds
+        self._seq.append(len(self) if seq is None else seq)
+        self._g.append(g)
         row += [_cell(v) for v in g]
         if self.has_temp:
             row.append(f"{temp:.2f}")
@@ -89,19 +112,20 @@ class SampleStore:
         self.flush()
         return self._writer.finish()
 
-    # -- views -----------------------------------------------------------------------------------------------
+    # -- views (no copies) -----------------------------------------------------------------------------------
 
     @property
     def t(self) -> np.ndarray:
-        return np.asarray(self._t, dtype=float)
+        """[s] from the first sample."""
+        return self._t.view
 
     @property
     def gyro(self) -> np.ndarray:
-        return np.asarray(self._g, dtype=float).reshape(-1, 3)
+        return self._g.view
 
     @property
     def seq(self) -> np.ndarray:
-        return np.asarray(self._seq, dtype=np.int64)
+        return self._seq.view
 
     def samples_by_seq(self, start: int, stop: int) -> np.ndarray | None:
         """Samples with sequence numbers ``start:stop`` when every one of them was received, else None."""
@@ -110,12 +134,11 @@ class SampleStore:
         j = i + (stop - start)
         if j > len(seq) or seq[i] != start or seq[j - 1] != stop - 1:
             return None
-        return self.gyro[i:j]
+        return self.gyro[i:j].copy()
 
-    def recording(self, units: str, sensitivity: float | None, sample_rate: float | None = None,
-                  start: int = 0) -> Recording:
-        """The samples from `start` on as a :class:`Recording` (rad/s when the unit or sensitivity allows)."""
-        g = self.gyro[start:]
+    def recording(self, units: str, sensitivity: float | None, sample_rate: float | None = None) -> Recording:
+        """The samples so far as a :class:`Recording` (rad/s when the unit or sensitivity allows)."""
+        g = self.gyro.copy()
         if units == "counts":
             factor = None if sensitivity is None else unit_factor("deg/s") / sensitivity
         else:
@@ -124,6 +147,5 @@ class SampleStore:
         gyro = g if factor is None else g * factor
         internal = "counts" if factor is None else "rad/s"
         if self.has_time:
-            t = self.t[start:]
-            return Recording(t=t, gyro=gyro, units=internal, sample_rate=sample_rate or 0.0, **kwargs)
+            return Recording(t=self.t.copy(), gyro=gyro, units=internal, sample_rate=sample_rate or 0.0, **kwargs)
         return Recording.from_rate(gyro, sample_rate, units=internal, **kwargs)

@@ -76,7 +76,7 @@ class TextDecoder:
             if all(str(v).strip().isdigit() for v in columns.values()):
                 cols = {k: int(v) - 1 for k, v in columns.items()}
                 if min(cols.values()) < 0:
-                    raise InputError(f"column numbers count from 1, got columns={columns!r}")
+                    raise InputError(f"column numbers count from 1, got {columns!r}", param="columns", value=columns)
                 self._use(cols, 1.0)
             else:
                 self._names = dict(columns)
@@ -97,7 +97,8 @@ class TextDecoder:
     def _use(self, cols: dict[str, int], t_scale: float) -> None:
         missing = [c for c in ("gx", "gy", "gz") if c not in cols]
         if missing:
-            raise InputError(f"columns gives no number for {', '.join(missing)}")
+            raise InputError(f"{{param}} gives no column for {', '.join(missing)}", param="columns",
+                             hint="map them, e.g. {param} t=1,gx=2,gy=3,gz=4")
         self._numbers, self._t_scale = cols, t_scale
         self._width = max(cols.values()) + 1
 

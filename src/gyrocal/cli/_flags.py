@@ -14,6 +14,7 @@ FLAGS: dict[str, str] = {
     # reading
     "units": "--units",
     "columns": "--columns",
+    "skip_rows": "--skip-rows",
     "sample_rate": "--sample-rate",
     "sensitivity": "--sensitivity",
     "output_units": "--output-units",
@@ -57,6 +58,15 @@ FLAGS: dict[str, str] = {
     "quantum": "--quantum",
     "bias_instability": "--bias-instability",
     "rate_random_walk": "--rrw",
+    # capture, simulate --device
+    "port": "--port",
+    "baud": "--baud",
+    "wire": "--wire",
+    "samples": "--samples",
+    "silence": "--silence",
+    "guide": "--guide",
+    "faults": "--faults",
+    "pace": "--pace",
     # simulate --reference (a reference gyro's log) and verify, whose reading flags for the reference
     # carry the prefix ref_ (see cli/_reading.py: prefixed_params)
     "reference": "--reference",

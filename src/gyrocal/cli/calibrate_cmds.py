@@ -30,13 +30,17 @@ EXAMPLE_SPEED = 60.0  # deg/s, the servo protocol of Wang et al.
 
 
 WindowsFile = Annotated[Optional[Path], typer.Option(
-    "--windows", help="Windows file (JSON/CSV list, or imucal's section list) that replaces detection.")]
+    "--windows", help="Windows file (JSON/CSV list, or imucal's section list) that replaces detection "
+    "(default: detected).")]
 Speed = Annotated[Optional[float], typer.Option(
-    "--speed", help="Known constant turn rate, in the data's rate unit (deg/s with --units deg/s).")]
+    "--speed", help="Known constant turn rate, in the data's rate unit (deg/s with --units deg/s; --output-units "
+    "for counts) (default: none, --angle 360).")]
 Angle = Annotated[Optional[float], typer.Option(
-    "--angle", help="Known angle of each turn, in degrees (e.g. 360); the speed may vary.")]
-PlotPath = Annotated[Optional[Path], typer.Option("--plot", help="Write a picture (.png, .pdf or .svg).")]
-Output = Annotated[Optional[Path], typer.Option("-o", "--output", help="Output file.")]
+    "--angle", help="Known angle of each turn, in degrees; the speed may vary (default: 360 unless --speed).")]
+PlotPath = Annotated[Optional[Path], typer.Option(
+    "--plot", help="Write a picture (.png, .pdf or .svg) (default: none).")]
+Output = Annotated[Optional[Path], typer.Option(
+    "-o", "--output", help="Calibration file to write (default: none; the parameters are printed).")]
 Force = Annotated[bool, typer.Option("--force", help="Replace an output that holds a different calibration.")]
 
 
@@ -84,7 +88,14 @@ def _density_to_internal(noise_density: str, noise_std: float | None, rec):
         raise InputError("give --noise-std or --noise-density, not both")
     if rec.units == "counts":
         raise InputError("--noise-density needs physical units; give --sensitivity with --units counts")
-    return noise_density_arg(noise_density) * math.sqrt(rec.sample_rate)
+    density = noise_density_arg(noise_density)
+    if not all(d > 0 for d in density):
+        axes = ", ".join(a for a, d in zip("xyz", density) if not d > 0)
+        raise InputError(f"{{param}} {noise_density} gives a zero noise density on {axes}, which would give a zero "
+                         "1-sigma (a noise file of all-zero or constant data?)", param="noise_density",
+                         value=noise_density, hint="measure the noise on a real static log (gyrocal noise), or "
+                         "leave {param} out to estimate it from the windows")
+    return density * math.sqrt(rec.sample_rate)
 
 
 def _windows_from_file(path: Optional[Path], rec):
@@ -105,25 +116,28 @@ def _example_paths() -> tuple[Path, Path]:
 def _params_table(run, truth=None):
     """Rich tables: k, b (the servo method of Wang et al.) in user units with 1-sigma (and the truth,
     for the example), and the canonical correction."""
-    import numpy as np
     from rich.markup import escape
     from rich.table import Table
 
     cal = run.calibration
+    matrix, offset = cal.correction
     table = Table()
-    for col in ("parameter", "estimate", "1-sigma") + (("truth", "error / sigma") if truth is not None else ()):
-        table.add_column(col, justify="left" if col == "parameter" else "right")
+    # b is added to the reading (Wang et al., eq. 1): the offset beside it is what the gyro reads at rest
+    for col in ("parameter", "estimate", "1-sigma", f"at rest\n[{cal.input_units}]") + (
+            ("truth", "error\n/ sigma") if truth is not None else ()):
+        table.add_column(escape(col), justify="left" if col == "parameter" else "right", no_wrap=True)
     true_values = None
     if truth is not None:
-        matrix, offset = truth.correction
-        true_values = list(np.diag(matrix)) + list(-offset)  # k, and b = -offset (Wang et al., eq. 1)
+        from ..pipeline import parameter_rows
+
+        true_values = [value for _, value, _, _ in parameter_rows(truth)]
     for i, (name, value, sigma, unit) in enumerate(run.parameters()):
-        row = [escape(f"{name} [{unit}]"), f"{value:.6g}", "n/a" if math.isnan(sigma) else f"{sigma:.2g}"]
+        rest = f"{offset[i - 3]:+.6g}" if i >= 3 else ""
+        row = [escape(f"{name} [{unit}]"), f"{value:.6g}", "n/a" if math.isnan(sigma) else f"{sigma:.2g}", rest]
         if true_values is not None:
             true = float(true_values[i])
             row += [f"{true:.6g}", f"{(value - true) / sigma:+.2f}" if sigma > 0 else "n/a"]
         table.add_row(*row)
-    matrix, offset = cal.correction
     canon = Table()
     for label in ("matrix", "", "", "offset"):
         canon.add_column(label, justify="right")
@@ -133,6 +147,8 @@ def _params_table(run, truth=None):
 
 
 def _print_calibration(run, truth=None) -> None:
+    import numpy as np
+
     from ..segmentation import describe_found
     from ..units import from_rad_s
 
@@ -141,8 +157,13 @@ def _print_calibration(run, truth=None) -> None:
     ref = (f"speed {from_rad_s(run.reference_value, cal.output_units):g} {cal.output_units}"
            if run.reference == "speed" else f"angle {math.degrees(run.reference_value):g} deg per turn")
     console.print(f"{cal.method}, {ref}: g = diag(k) (m + b), the servo method of Wang et al., eq. 1",
-                  highlight=False)
+                  highlight=False, soft_wrap=True)
     console.print(table)
+    if cal.input_units == "counts" and cal.sensitivity is not None:
+        k = np.asarray(cal.model.params[:3])
+        console.print(f"k is relative to --sensitivity {cal.sensitivity:g} LSB per {cal.output_units}: the measured "
+                      f"sensitivity is {', '.join(f'{cal.sensitivity / v:.5g}' for v in k)} LSB per "
+                      f"{cal.output_units} (x, y, z)", highlight=False, soft_wrap=True)
     console.print(f"correction w_true = matrix @ (raw - offset), raw in {cal.input_units}, "
                   f"w_true in {cal.output_units}", highlight=False)
     console.print(canon)
@@ -155,6 +176,27 @@ def _print_calibration(run, truth=None) -> None:
     n_rot = sum(w.get("kind") == "rotation" for w in cal.windows)
     console.print(f"windows used: {n_rot} rotation, {len(cal.windows) - n_rot} static; found: "
                   f"{describe_found(run.segmentation.windows, run.segmentation.ignored)}", highlight=False, soft_wrap=True)
+    _print_checks(run)
+
+
+def _print_checks(run) -> None:
+    """What the self-checks found: time base, fit quality with the largest residuals, notes, warnings."""
+    for line in run.time_base.describe() if run.time_base is not None else ():
+        console.print(line, highlight=False, soft_wrap=True, markup=False)
+    q = run.quality
+    if q is None:
+        return
+    console.print(q.summary(), highlight=False, soft_wrap=True, markup=False)
+    if q.dof > 0:
+        size = [(sum(v * v for v in z) ** 0.5, i) for i, z in enumerate(q.residuals)]
+        top = sorted(size, reverse=True)[:5]
+        console.print("  largest residuals [noise sigma]: " + ", ".join(
+            f"window {i} ({q.labels[i]}) {' '.join(f'{v:+.2f}' for v in q.residuals[i])}" for _, i in top)
+            + f" ({len(size)} windows; all in the file's fit.residuals)", highlight=False, soft_wrap=True, markup=False)
+    for note in run.notes:
+        console.print(f"note: {note}", highlight=False, soft_wrap=True, markup=False)
+    for line in run.warnings:
+        warn(line)
 
 
 def _truth_calibration(path: Path, cal):
@@ -164,7 +206,8 @@ def _truth_calibration(path: Path, cal):
     from ..simulation.truth import SimulationTruth
 
     truth = load(path, SimulationTruth)
-    return Calibration(model=truth.model, input_units=cal.input_units, output_units=cal.output_units)
+    return Calibration(model=truth.model, input_units=cal.input_units, output_units=cal.output_units,
+                       sensitivity=cal.sensitivity)
 
 
 @app.command()
@@ -172,6 +215,7 @@ def calibrate(
     recording: Annotated[Optional[Path], typer.Argument(help="Recording: CSV, Parquet, or a ROS/MCAP bag.")] = None,
     units: READING.Units = None,
     columns: READING.Columns = None,
+    skip_rows: READING.SkipRows = None,
     sample_rate: READING.SampleRate = None,
     sensitivity: READING.Sensitivity = None,
     output_units: READING.OutputUnits = None,
@@ -183,15 +227,17 @@ def calibrate(
     windows: WindowsFile = None,
     method: Annotated[Method, typer.Option("--method", help="Estimator.")] = "first-moment",
     noise_std: Annotated[Optional[float], typer.Option(
-        "--noise-std", help="Per-sample noise, in the data's unit, instead of the one measured.")] = None,
+        "--noise-std", help="Per-sample noise, in the data's unit, instead of the one measured (default: "
+        "measured).")] = None,
     noise_density: Annotated[Optional[str], typer.Option(
         "--noise-density", help="Noise density instead of the one measured: a number [rad/s/sqrt(Hz)], "
-        "'N deg/s/rtHz', or a noise JSON from 'gyrocal noise --json'.")] = None,
+        "'N deg/s/rtHz', or a noise JSON from 'gyrocal noise --json' (default: measured).")] = None,
     output: Output = None,
     plot: PlotPath = None,
     force: Force = False,
     example: Annotated[bool, typer.Option(
-        "--example", help="Run on the bundled simulated MPU9250 servo recording (60 deg/s).")] = False,
+        "--example", help="Run on the bundled simulated MPU9250 servo recording (deg/s, --speed 60 unless "
+        "--angle or --windows).")] = False,
 ) -> None:
     """Estimate scale and bias from a recording of turns; print them with 1-sigma; write the calibration file."""
     from ..pipeline import calibrate as run_calibration
@@ -211,8 +257,9 @@ def calibrate(
     units = required_units(units)
     rate_unit = _rate_unit(units, output_units)
     reference, speed_rad, angle_rad = _reference(speed, angle, rate_unit)
-    rec = read_from_flags(recording, units=units, columns=columns, sample_rate=sample_rate, sensitivity=sensitivity,
-                          output_units=output_units, topic=topic, saturation=saturation, no_unit_check=no_unit_check)
+    rec = read_from_flags(recording, units=units, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
+                          sensitivity=sensitivity, output_units=output_units, topic=topic, saturation=saturation,
+                          no_unit_check=no_unit_check)
     win = _windows_from_file(windows, rec)
     noise = _noise_to_internal(noise_std, units, rate_unit, sensitivity)
     if noise_density is not None:
@@ -254,6 +301,7 @@ def segments(
     recording: Annotated[Path, typer.Argument(help="Recording: CSV, Parquet, or a ROS/MCAP bag.")],
     units: READING.Units = None,
     columns: READING.Columns = None,
+    skip_rows: READING.SkipRows = None,
     sample_rate: READING.SampleRate = None,
     sensitivity: READING.Sensitivity = None,
     output_units: READING.OutputUnits = None,
@@ -273,38 +321,47 @@ def segments(
     rate_unit = _rate_unit(units, output_units)
     reference, speed_rad, angle_rad = _reference(speed, angle, rate_unit)
     check_output(plot, flag="--plot", inputs=(recording, windows), force=True)
-    rec = read_from_flags(recording, units=units, columns=columns, sample_rate=sample_rate, sensitivity=sensitivity,
-                          output_units=output_units, topic=topic, saturation=saturation, no_unit_check=no_unit_check)
+    rec = read_from_flags(recording, units=units, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
+                          sensitivity=sensitivity, output_units=output_units, topic=topic, saturation=saturation,
+                          no_unit_check=no_unit_check)
     given = _windows_from_file(windows, rec)
     ignored: list = []
     if given is not None:
-        found, source = given, f"from {windows}"
+        from ..segmentation import standstill_level
+
+        found, source, baseline = given, f"from {windows}", standstill_level(rec, given)
     else:
         from ..segmentation import segment
 
         # Show what was found even when it is not enough to calibrate; warn after the table.
         seg = segment(rec, reference=reference, speed=speed_rad, angle=angle_rad or 2 * math.pi, require=False)
-        found, ignored, source = list(seg.windows), list(seg.ignored), "detected"
+        found, ignored, source, baseline = list(seg.windows), list(seg.ignored), "detected", seg.baseline
+    tb = rec.time_base()
+    times = tb.clock_times()
+    times = rec.t if times is None else times
     disp = "counts" if rec.units == "counts" else rate_unit
-    console.print(f"{len(found)} windows {source} in {recording.name} ({len(rec)} samples, {rec.sample_rate:.4g} Hz)",
-                  highlight=False, markup=False)
+    declared = (f"{speed:g} {rate_unit}" if reference == "speed" else f"{360.0 if angle is None else angle:g} deg")
+    console.print(f"{len(found)} windows {source} in {recording.name} ({len(rec)} samples, {rec.sample_rate:.4g} Hz); "
+                  f"declared {reference} {declared}; angles and rates below are measured (raw readings, standstill "
+                  "level removed, before calibration)", highlight=False, markup=False, soft_wrap=True)
+    for line in tb.describe():
+        console.print(line, highlight=False, markup=False, soft_wrap=True)
+    angle_unit = "counts s" if rec.units == "counts" else "deg"
     table = Table()
-    for col in ("#", "kind", "turn", "start", "stop", "t0 [s]", "length [s]", "angle [deg]", f"mean rate [{disp}]"):
+    for col in ("#", "kind", "turn", "start", "stop", "t0 [s]", "length [s]", f"angle [{angle_unit}]",
+                f"mean rate [{disp}]"):
         table.add_column(escape(col), justify="right" if col not in ("kind", "turn") else "left")
     for i, w in enumerate(found):
-        turn = "" if w.kind == "static" else f"{'+' if w.sign > 0 else '-' if w.sign < 0 else ''}{w.axis or '?'}"
-        rate = "" if math.isnan(w.rate) else f"{_rate_display(w.rate, rec, disp):.4g}"
-        ang = "" if math.isnan(w.angle) else f"{math.degrees(w.angle):.1f}"
-        table.add_row(str(i), w.kind, turn, str(w.start), str(w.stop), f"{rec.t[w.start]:.2f}",
-                      f"{(w.stop - w.start) / rec.sample_rate:.2f}", ang, rate)
+        table.add_row(str(i), w.kind, _turn(w), str(w.start), str(w.stop), f"{rec.t[w.start]:.2f}",
+                      f"{times[w.stop - 1] - times[w.start]:.2f}", *_measured(rec, w, baseline, times, disp))
     console.print(table)
     if ignored:
         console.print(f"{len(ignored)} ignored:")
         skipped = Table()
-        for col in ("start", "stop", "why"):
-            skipped.add_column(col)
+        for col in ("start", "stop", "turn", f"angle [{angle_unit}]", f"mean rate [{disp}]", "why"):
+            skipped.add_column(escape(col), justify="left" if col in ("turn", "why") else "right")
         for w, why in ignored:
-            skipped.add_row(str(w.start), str(w.stop), why)
+            skipped.add_row(str(w.start), str(w.stop), _turn(w), *_measured(rec, w, baseline, times, disp), why)
         console.print(skipped)
     else:
         console.print("nothing ignored")
@@ -321,8 +378,18 @@ def segments(
         console.print(f"wrote {plot}", highlight=False)
 
 
-def _rate_display(rate: float, rec, unit: str) -> float:
-    """A window's mean rate [internal units] in the display unit."""
+def _turn(w) -> str:
+    return "" if w.kind == "static" else f"{'+' if w.sign > 0 else '-' if w.sign < 0 else ''}{w.axis or '?'}"
+
+
+def _measured(rec, w, baseline, times, unit: str) -> tuple[str, str]:
+    """A rotation window's measured angle and mean rate, as printed (blank for a static window)."""
+    from ..segmentation import measure_turn
     from ..units import from_rad_s
 
-    return rate if rec.units == "counts" else float(from_rad_s(rate, unit))
+    if w.kind == "static":
+        return "", ""
+    angle, rate = measure_turn(rec, w, baseline, times)
+    if rec.units == "counts":
+        return f"{angle:.4g}", f"{rate:.4g}"
+    return f"{math.degrees(angle):.1f}", f"{float(from_rad_s(rate, unit)):.4g}"

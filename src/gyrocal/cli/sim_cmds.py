@@ -12,7 +12,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from ..choices import Protocol
+from ..choices import DeviceWire, Protocol
 from ..errors import InputError
 from ._options import NoiseDensity, given, noise_std, numbers, refuse_unused, triple
 from ._outputs import check_output, json_format, starts_with
@@ -54,8 +54,8 @@ def _turntable_protocol(temps: str | None, rates: str | None, step_duration: flo
 @app.command()
 def simulate(
     ctx: typer.Context,
-    output: Annotated[Path, typer.Option(
-        "-o", "--output", help="Recording to write (CSV); the truth goes to *.truth.json.")],
+    output: Annotated[Path | None, typer.Option(
+        "-o", "--output", help="Recording to write (CSV); the truth goes to *.truth.json (required, except with --device).")] = None,
     protocol: Annotated[Protocol, typer.Option("--protocol", help="Motion source.")] = "servo",
     speed: Annotated[float, typer.Option("--speed", help="Servo/hand turn speed [deg/s].")] = 60.0,
     turns: Annotated[str, typer.Option("--turns", help="Turns, comma-separated.")] = "+x,-x,+y,-y,+z,-z",
@@ -64,18 +64,18 @@ def simulate(
     vibration: Annotated[float, typer.Option("--vibration", help="RMS speed vibration, fraction of speed.")] = 0.05,
     misalignment: Annotated[float, typer.Option("--misalignment", help="Mounting misalignment [deg], <= 10.")] = 5.0,
     k: Annotated[Optional[str], typer.Option(
-        "--k", help="True scale factors kx,ky,kz (the servo method of Wang et al., eq. 1).")] = None,
+        "--k", help="True scale factors kx,ky,kz (the servo method of Wang et al., eq. 1) (default: 1,1,1).")] = None,
     b: Annotated[Optional[str], typer.Option(
-        "--b", help="True biases bx,by,bz [rad/s] (the servo method of Wang et al., eq. 1).")] = None,
-    noise: Annotated[Optional[float], typer.Option("--noise", help="Per-sample white noise [rad/s].")] = None,
+        "--b", help="True biases bx,by,bz [rad/s] (the servo method of Wang et al., eq. 1) (default: 0,0,0).")] = None,
+    noise: Annotated[Optional[float], typer.Option("--noise", help="Per-sample white noise [rad/s] (default: 0.035, the paper's; 0.005 for the turntable).")] = None,
     noise_density: NoiseDensity = None,
     bias_instability: Annotated[float, typer.Option("--bias-instability", help="Gauss-Markov bias std [rad/s].")] = 0.0,
     rate_random_walk: Annotated[float, typer.Option("--rrw", help="Rate random walk [rad/s/sqrt(s)].")] = 0.0,
-    quantum: Annotated[Optional[float], typer.Option("--quantum", help="Output resolution [rad/s].")] = None,
-    full_scale: Annotated[Optional[float], typer.Option("--full-scale", help="Saturation [deg/s].")] = None,
-    profile: Annotated[Optional[Path], typer.Option("--profile", help="--protocol profile: CSV of t,wx,wy,wz.")] = None,
+    quantum: Annotated[Optional[float], typer.Option("--quantum", help="Output resolution [rad/s] (default: none, not quantised).")] = None,
+    full_scale: Annotated[Optional[float], typer.Option("--full-scale", help="Saturation [deg/s] (default: none, never saturates).")] = None,
+    profile: Annotated[Optional[Path], typer.Option("--profile", help="--protocol profile: CSV of t,wx,wy,wz (required there).")] = None,
     profile_units: Annotated[str, typer.Option("--profile-units", help="Unit of the profile rates.")] = "rad/s",
-    duration: Annotated[Optional[float], typer.Option("--duration", help="--protocol profile: length [s].")] = None,
+    duration: Annotated[Optional[float], typer.Option("--duration", help="--protocol profile: length [s] (required there).")] = None,
     temps: Annotated[Optional[str], typer.Option(
         "--temps", help="--protocol turntable: temperatures [degC], comma-separated (default: the full-temperature-"
                         "range method's Table 1, -40 to 50 by 10).")] = None,
@@ -88,7 +88,7 @@ def simulate(
     temp_noise: Annotated[float, typer.Option(
         "--temp-noise", help="--protocol turntable: std of each temperature reading [degC].")] = 0.0,
     temp_quantum: Annotated[Optional[float], typer.Option(
-        "--temp-quantum", help="--protocol turntable: resolution of the temperature readings [degC], e.g. 1.")]
+        "--temp-quantum", help="--protocol turntable: resolution of the temperature readings [degC], e.g. 1 (default: none, not quantised).")]
     = None,
     sample_rate: Annotated[float, typer.Option("--sample-rate", help="Sampling rate [Hz].")] = 200.0,
     units: Annotated[str, typer.Option("--units", help="Unit of the written gyro columns.")] = "deg/s",
@@ -109,6 +109,16 @@ def simulate(
     ref_units: Annotated[str, typer.Option("--ref-units", help="Unit of the reference's gyro columns.")] = "deg/s",
     force: Annotated[bool, typer.Option("--force", help="Replace an -o file that gyrocal simulate did not write.")]
     = False,
+    device: Annotated[bool, typer.Option(
+        "--device", help="Serve a servo or hand session on a pseudo-terminal as a board would, for 'gyrocal "
+                         "capture --port ...' (raw counts at 131 LSB per deg/s; frames are the example firmware's: "
+                         "samples, its own six-turn calibration, corrected samples).")] = False,
+    wire: Annotated[DeviceWire, typer.Option("--wire", help="--device: gyrocal frames or text lines.")] = "frames",
+    faults: Annotated[str | None, typer.Option(
+        "--faults", help="--device: drop=P,corrupt=P (per byte),stall=AT:SECONDS,disconnect=AT (AT: fraction of "
+                         "the stream) (default: none).")] = None,
+    pace: Annotated[float, typer.Option(
+        "--pace", help="--device: 1 = real time, 10 = ten times faster, 0 = as fast as the reader reads.")] = 1.0,
 ) -> None:
     """Simulate a recording (servo, hand, turntable or profile) with its truth sidecar."""
     import numpy as np
@@ -122,6 +132,16 @@ def simulate(
 
     refuse_unused(ctx, _PROTOCOL_FLAGS, protocol, "--protocol")
     _refuse_reference_flags(ctx, reference)
+    if device and reference is not None:
+        raise InputError("--reference writes a second log; it does not go with --device (leave one out)")
+    if device:
+        return _serve_device(protocol, speed, turns, wait, misalignment, k, b, noise, noise_density, sample_rate,
+                             seed, wire, faults, pace)
+    for name in ("wire", "faults", "pace"):
+        if given(ctx, name):
+            raise InputError(f"--{name} is for --device only; add --device or leave --{name} out")
+    if output is None:
+        raise InputError("give -o FILE.csv for the recording (or --device to serve a session on a pseudo-terminal)")
     truth_file = truth_path(output)
     check_output(output, inputs=(profile,), force=force, replaceable=starts_with(f"# {_SIMULATED}"))
     check_output(truth_file, flag="truth file", inputs=(profile,), force=force,
@@ -219,3 +239,38 @@ def _reference_log(t, true_rates, path: Path, rng, *, sample_rate: float, offset
         rec, truth = simulate_reference(t, true_rates, gyro, sample_rate=sample_rate, time_offset_s=offset,
                                         clock_drift_ppm=drift, mounting_deg=mounting, rng=rng)
     return rec, {"path": path.name, **truth.to_dict()}
+
+
+def _serve_device(protocol, speed, turns, wait, misalignment, k, b, noise, noise_density, sample_rate, seed, wire,
+                  faults, pace) -> None:
+    """``simulate --device``: a simulated session served on a pseudo-terminal until it is read to the end."""
+    import numpy as np
+
+    from ..capture.device import VirtualDevice, damage, device_bytes, parse_faults
+    from ..capture.simulated import simulate_device_session
+    from ..models import ScaleBias
+    from ..simulation.servo import ServoProtocol
+
+    if protocol not in _SERVO:
+        raise InputError(f"--device serves servo or hand sessions, got --protocol {protocol}")
+    if not pace >= 0:
+        raise InputError(f"--pace must be >= 0, got {pace!r}")
+    fault = parse_faults(faults, seed)
+    turn_list = tuple(t.strip() for t in turns.split(",") if t.strip())
+    kw = dict(speed=math.radians(speed), wait=wait, misalignment_deg=misalignment, lead_in=3.0)
+    proto = ServoProtocol.hand(turn_list, **kw) if protocol == "hand" else ServoProtocol(turns=turn_list, **kw)
+    sd = noise_std(noise, noise_density, sample_rate, 0.01)
+    model = ScaleBias(triple("--k", k, (1.0, 1.0, 1.0)), triple("--b", b, (0.0, 0.0, 0.0)))
+    session = simulate_device_session(proto, model=model, noise_std=sd, rng=np.random.default_rng(seed),
+                                      sample_rate=sample_rate)
+    data, _ = damage(device_bytes(session, wire), fault)
+    rate = None if pace == 0 else len(data) / (len(session) / sample_rate) * pace
+    with VirtualDevice(data, faults=fault, byte_rate=rate, wait_for="reader") as dev:
+        port = dev.start()
+        console.print(f"virtual device on {port}: {protocol} session, {len(session)} samples "
+                      f"({len(session) / sample_rate:.0f} s at {sample_rate:g} Hz), {wire}; it starts when a reader "
+                      f"opens the port, e.g.\n  gyrocal capture --port {port} -o rec.csv --guide {protocol}",
+                      highlight=False, soft_wrap=True, markup=False)
+        while not dev.wait(1.0):
+            pass
+    console.print(f"sent {dev.sent:,} bytes; the device closed the link", highlight=False)

@@ -1,4 +1,4 @@
-"""The first-moment estimator (SPEC, Method S): unbiased, with a data-driven covariance.
+"""The first-moment estimator (docs/core.md, Estimators): unbiased, with a data-driven covariance.
 
 Rotation windows give norm equations on the window mean,
 
@@ -27,19 +27,21 @@ from ._lm import batched_lm
 from ._noise import estimate_noise_var
 from ._result import BatchFit, FitResult
 
-__all__ = ["FirstMoment", "estimate_noise_var", "first_moment_batch", "residuals_and_jacobian", "sandwich_covariance"]
+__all__ = ["FirstMoment", "estimate_noise_var", "first_moment_batch", "residuals_and_jacobian", "row_noise_var",
+           "row_variance", "sandwich_covariance"]
 
 PARAM_NAMES = ("kx", "ky", "kz", "bx", "by", "bz")
 
 
-def residuals_and_jacobian(p: np.ndarray, obs: ObservationSet) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def residuals_and_jacobian(p: np.ndarray, obs: ObservationSet,
+                           row_scale: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Weighted residuals (B, m), Jacobian (B, m, 6) and each row's noise sensitivity.
 
     Rows are the rotation windows, then three rows per static window, each weighted
-    by ``sqrt(count)``. The third output (B, m, 3) is the derivative of a weighted row
-    with respect to one sample's reading: a window mean of ``n`` samples has variance
-    ``sigma^2 / n`` and the row weight is ``sqrt(n)``, so the two cancel. It feeds
-    :func:`sandwich_covariance`.
+    by ``sqrt(count)`` (times `row_scale` (B, m) when given). The third output (B, m, 3)
+    is the derivative of a weighted row with respect to one sample's reading: a window
+    mean of ``n`` samples has variance ``sigma^2 / n`` and the row weight is ``sqrt(n)``,
+    so the two cancel. It feeds :func:`sandwich_covariance`.
     """
     k, b = p[:, None, :3], p[:, None, 3:]
     rot, sta = ~obs.static, obs.static
@@ -59,23 +61,54 @@ def residuals_and_jacobian(p: np.ndarray, obs: ObservationSet) -> tuple[np.ndarr
     J_sta = np.concatenate([eye * ms[..., None], eye * k_sta[..., None]], axis=-1) * w_sta[..., None]
     S_sta = eye * k_sta[..., None]
     B = len(p)
-    return (
-        np.concatenate([r_rot, r_sta], axis=1),
-        np.concatenate([J_rot, J_sta.reshape(B, -1, 6)], axis=1),
-        np.concatenate([S_rot, S_sta.reshape(B, -1, 3)], axis=1),
-    )
+    r = np.concatenate([r_rot, r_sta], axis=1)
+    J = np.concatenate([J_rot, J_sta.reshape(B, -1, 6)], axis=1)
+    S = np.concatenate([S_rot, S_sta.reshape(B, -1, 3)], axis=1)
+    if row_scale is not None:
+        r, J, S = r * row_scale, J * row_scale[..., None], S * row_scale[..., None]
+    return r, J, S
 
 
-def sandwich_covariance(J: np.ndarray, S: np.ndarray, noise_var: np.ndarray) -> np.ndarray:
-    """Covariance (B, 6, 6) of the weighted fit with per-axis noise `noise_var` (B, 3).
+def row_noise_var(obs: ObservationSet, noise_var: np.ndarray) -> np.ndarray:
+    """Per-sample-equivalent noise variance (B, m, 3) behind each row, ``count x var(window mean)``.
+
+    Windows with a measured mean variance (``obs.mean_var``) use it; the others white noise
+    `noise_var` (B, 3). Row order as in :func:`residuals_and_jacobian`.
+    """
+    obs = obs.as_batch()
+    nu = np.broadcast_to(noise_var[:, None, :], obs.mean.shape)
+    if obs.mean_var is not None:
+        nu = np.where(np.isnan(obs.mean_var), nu, obs.mean_var * obs.count[None, :, None])
+    return np.concatenate([nu[:, ~obs.static], np.repeat(nu[:, obs.static], 3, axis=1)], axis=1)
+
+
+def row_variance(obs: ObservationSet, S: np.ndarray, nu: np.ndarray, row_scale: np.ndarray | None = None):
+    """Variance (B, m) of each weighted row: window-mean noise ``sum_j S^2 nu``, plus the reference's.
+
+    A rotation row ``sqrt(count) (|k (m + b)| - rate)`` (times `row_scale`) carries the reference
+    rate's own variance ``count rate_var`` too (a turn whose angle a time-stamp gap leaves uncertain).
+    """
+    var = np.einsum("bmj,bmj->bm" if nu.ndim == 3 else "bmj,bj->bm", S * S, nu)
+    if obs.rate_var is not None:
+        extra = np.zeros(var.shape[-1])
+        n_rot = int((~obs.static).sum())
+        extra[:n_rot] = (obs.count * obs.rate_var)[~obs.static]
+        var = var + extra * (1.0 if row_scale is None else row_scale**2)
+    return var
+
+
+def sandwich_covariance(J: np.ndarray, S: np.ndarray, noise_var: np.ndarray,
+                        row_var: np.ndarray | None = None) -> np.ndarray:
+    """Covariance (B, 6, 6) of the weighted fit with per-axis noise `noise_var` (B, 3), or (B, m, 3) per row.
 
     ``H^-1 J^T Sigma J H^-1`` with ``H = J^T J`` and ``Sigma`` the row covariance implied
-    by independent per-axis white noise of each window mean.
+    by independent per-axis noise of each window mean (or `row_var` (B, m), when given).
     """
     H = np.einsum("bmi,bmj->bij", J, J)
     # Rows of one static window share no noise across axes, and windows are independent,
     # so Sigma is diagonal: sum_j S_rj^2 sigma_j^2.
-    sigma_rows = np.einsum("bmj,bj->bm", S * S, noise_var)
+    sigma_rows = row_var if row_var is not None else np.einsum(
+        "bmj,bmj->bm" if noise_var.ndim == 3 else "bmj,bj->bm", S * S, noise_var)
     meat = np.einsum("bmi,bm,bmj->bij", J, sigma_rows, J)
     Hinv = np.linalg.inv(H)
     return Hinv @ meat @ Hinv
@@ -138,7 +171,7 @@ def first_moment_batch(
     obs = obs.as_batch()
     n_rot, n_sta = int((~obs.static).sum()), int(obs.static.sum())
     require_count(n_rot + 3 * n_sta, f"{n_rot} rotation and {n_sta} static window(s)")
-    if not (closed_form and n_rot == 6 and n_sta == 0):
+    if not (closed_form and n_rot == 6 and n_sta == 0 and obs.mean_var is None and obs.rate_var is None):
         return _lm_fit(obs, _noise_var(obs, noise_var), max_iter)
     initial_guess(obs.take([0]))  # the design checks, with their specific messages
     # Without a known noise level, the closed form estimates it chunk by chunk, in cache.
@@ -176,20 +209,33 @@ def _noise_var(obs: ObservationSet, noise_var) -> np.ndarray:
 
 
 def _lm_fit(obs: ObservationSet, nv: np.ndarray, max_iter: int) -> BatchFit:
-    """The general path: Levenberg–Marquardt from the per-axis linear start."""
+    """The general path: Levenberg–Marquardt from the per-axis linear start.
+
+    With measured window-mean variances (``obs.mean_var``) the rows are weighted by their own
+    noise (at the start point), so the weighted residuals are in noise units; otherwise by
+    ``sqrt(count)``.
+    """
     p0 = initial_guess(obs)
-    fun = lambda p: residuals_and_jacobian(p, obs)[:2]
+    nu, scale = nv, None
+    if obs.mean_var is not None or obs.rate_var is not None:
+        nu = row_noise_var(obs, nv)
+        _, _, S0 = residuals_and_jacobian(p0, obs)
+        scale = 1.0 / np.sqrt(row_variance(obs, S0, nu))
+
+    def fun(p):
+        return residuals_and_jacobian(p, obs, scale)[:2]
     p, iterations, converged, residuals, history = batched_lm(fun, p0, max_iter=max_iter)
     require_converged(converged, iterations, "first-moment least squares")
     # The norm equations cannot see the sign of k; a positive scale is the physical one.
     p[:, :3] = np.abs(p[:, :3])
     history[..., :3] = np.abs(history[..., :3])
     require_positive_k2(p[:, :3] ** 2, "first-moment least squares")
-    _, J, S = residuals_and_jacobian(p, obs)
+    _, J, S = residuals_and_jacobian(p, obs, scale)
     require_full_rank(J[0], PARAM_NAMES, "the windows")
     return BatchFit(
         method="first-moment", k=p[:, :3], b=p[:, 3:], iterations=iterations, converged=converged,
-        residuals=residuals, covariance=sandwich_covariance(J, S, nv), noise_std=np.sqrt(nv), history=history,
+        residuals=residuals, covariance=sandwich_covariance(J, S, nu, row_variance(obs, S, nu, scale)),
+        noise_std=np.sqrt(nv), history=history,
     )
 
 

@@ -48,6 +48,17 @@ def gamma_gradient(beta: np.ndarray) -> np.ndarray:
     return np.concatenate([-beta[:, 3:] ** 2 / (4 * beta[:, :3] ** 2), beta[:, 3:] / (2 * beta[:, :3])], axis=1)
 
 
+def paper_row_var(beta: np.ndarray, obs: ObservationSet, nv: np.ndarray) -> np.ndarray:
+    """Variance (B, n) of each row ``beta0 + x . beta - y`` under white noise of variance `nv` (B, 3).
+
+    See :func:`kb_covariance` for the derivation.
+    """
+    obs = obs.as_batch()
+    b1, b2 = beta[:, None, :3], beta[:, None, 3:]
+    s2 = nv[:, None, :]
+    return np.sum(s2 * ((2 * b1 * obs.mean + b2) ** 2 + 2 * b1**2 * s2), axis=-1) / obs.count
+
+
 def kb_covariance(beta: np.ndarray, obs: ObservationSet, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Covariance (B, 6, 6) of ``(k, b)`` from the regression, and the noise variance (B, 3) used.
 
@@ -56,13 +67,11 @@ def kb_covariance(beta: np.ndarray, obs: ObservationSet, X: np.ndarray) -> tuple
     correlated by ``2 mu_j s_j^2 / n``. A row ``beta0 + x . beta - y`` therefore has variance
     ``sum_j s_j^2 ((2 beta_j mu_j + beta_{j+3})^2 + 2 beta_j^2 s_j^2) / n``. The least-squares
     sandwich gives the covariance of ``beta``, and the delta method that of ``(k, b)``. It is
-    the spread over noise draws; the bias of the mean-of-squares form (SPEC) comes on top.
+    the spread over noise draws; the bias of the mean-of-squares form (docs/core.md, Accuracy) comes on top.
     """
     obs = obs.as_batch()
     nv = estimate_noise_var(obs)
-    b1, b2 = beta[:, None, :3], beta[:, None, 3:]
-    s2 = nv[:, None, :]
-    row_var = np.sum(s2 * ((2 * b1 * obs.mean + b2) ** 2 + 2 * b1**2 * s2), axis=-1) / obs.count
+    row_var = paper_row_var(beta, obs, nv)
     J = X + gamma_gradient(beta)[:, None, :]  # X: the regressors (B, n, 6) of :func:`regressors`
     # d beta = A e with e the rows' unit-variance errors: A = J^-1 sqrt(row_var) (square J), else H^-1 J^T sqrt(..)
     if J.shape[1] == J.shape[2]:

@@ -113,6 +113,19 @@ def _split_turnarounds(runs, level, labels, csum, high, min_len) -> np.ndarray:
     return np.stack([np.sort(np.concatenate((runs[:, 0], pts))), np.sort(np.concatenate((runs[:, 1], pts)))], axis=1)
 
 
+def _neighbours(points: np.ndarray, radius: float):
+    """How many of `points` (q, 3) lie within `radius` of each, and a look-up of one's neighbours.
+
+    A k-d tree keeps memory linear in q; a pairwise distance matrix was most of the peak
+    memory of a long recording.
+    """
+    from scipy.spatial import cKDTree
+
+    tree = cKDTree(points)
+    count = tree.query_ball_point(points, radius, return_length=True, p=2.0)
+    return np.asarray(count), lambda i: np.asarray(tree.query_ball_point(points[i], radius), dtype=np.intp)
+
+
 def static_level(gyro: np.ndarray, block: int) -> tuple[np.ndarray, np.ndarray, float]:
     """Baseline, per-sample noise and bias drift of the standstill blocks of `block` samples.
 
@@ -129,15 +142,15 @@ def static_level(gyro: np.ndarray, block: int) -> tuple[np.ndarray, np.ndarray, 
     std = np.sqrt(np.maximum(np.einsum("nki,nki->ni", b, b) / block - mean**2, 0.0))
     q = np.linalg.norm(std, axis=1)
     quiet = np.flatnonzero(q <= 2.0 * np.percentile(q, 10) + 1e-300)
-    quiet = quiet[:: max(1, len(quiet) // _MAX_CLUSTER)]
+    # at most _MAX_CLUSTER blocks, evenly spread (a floor-division stride let up to twice as many through)
+    quiet = quiet[np.linspace(0, len(quiet) - 1, min(len(quiet), _MAX_CLUSTER)).astype(np.intp)]
     m, s = mean[quiet], std[quiet]
     radius = 6.0 * float(np.linalg.norm(np.median(s, axis=0))) / np.sqrt(block) + 1e-12 * float(np.abs(m).max())
+    count, members_of = _neighbours(m, radius)
     sq = np.einsum("ij,ij->i", m, m)
-    d2 = sq[:, None] + sq[None, :] - 2.0 * m @ m.T
-    count = (d2 < radius**2).sum(axis=1)
     # Of the dense levels, standstill is the smallest: biases are small next to any turn.
-    dense = np.flatnonzero(count >= max(2, 0.05 * count.max()))
-    members = d2[dense[np.argmin(sq[dense])]] < radius**2
+    dense = np.flatnonzero(count >= min(int(count.max()), max(2, 0.05 * count.max())))
+    members = members_of(int(dense[np.argmin(sq[dense])]))
     base = np.median(m[members], axis=0)
     sd = np.median(s[members], axis=0)
     # Bias drift between pauses: the spread of the standstill levels beyond what noise explains

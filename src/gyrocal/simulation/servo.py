@@ -50,8 +50,9 @@ class ServoProtocol:
         Plateau speed of every turn [rad/s] (the servo method of Wang et al.: 60 deg/s).
     turns : tuple of str
         Turns in order, each ``+x``, ``-x``, ``+y``, ``-y``, ``+z`` or ``-z``; repeats allowed.
-    revolutions : float
-        Revolutions per turn; each turn turns exactly ``2 pi revolutions`` [rad].
+    revolutions : float or tuple of float
+        Revolutions per turn; each turn turns exactly ``2 pi revolutions`` [rad]. A tuple gives
+        one per turn (a robot's turns of 135 to 270 deg, a hand's uneven tilts).
     wait : float or tuple of float
         Static time between turns [s] (the servo method of Wang et al.: 3 s); a tuple gives one per gap.
     lead_in, lead_out : float
@@ -72,11 +73,18 @@ class ServoProtocol:
         Stops inside each turn (a hand turn done as several pieces).
     pause_length : float
         Length of each stop [s].
+    ripple : float
+        Amplitude of a sinusoidal speed ripple as a fraction of `speed` (a motor's or robot
+        joint's velocity ripple), in [0, 0.5]. It is a bounded angle error, faded in over the
+        ramps, so every turn still turns exactly its angle; the mean speed over a plateau
+        differs from the commanded one by up to ``ripple * speed / (pi * ripple_freq * T)``.
+    ripple_freq : float
+        Frequency of the ripple [Hz].
     """
 
     speed: float = math.radians(60.0)
     turns: tuple[str, ...] = PAPER_TURNS
-    revolutions: float = 1.0
+    revolutions: float | tuple[float, ...] = 1.0
     wait: float | tuple[float, ...] = 3.0
     lead_in: float = 2.0
     lead_out: float = 2.0
@@ -87,11 +95,18 @@ class ServoProtocol:
     unevenness: float = 0.0
     pauses: int = 0
     pause_length: float = 0.3
+    ripple: float = 0.0
+    ripple_freq: float = 2.5
     _parsed: tuple[tuple[int, int], ...] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
         positive("speed", self.speed)
-        positive("revolutions", self.revolutions)
+        if not np.isscalar(self.revolutions):
+            object.__setattr__(self, "revolutions", tuple(float(r) for r in self.revolutions))
+        revs = np.atleast_1d(np.asarray(self.revolutions, dtype=float))
+        if revs.size not in (1, len(self.turns)) or not np.all(revs > 0) or not np.all(np.isfinite(revs)):
+            raise InputError(f"revolutions must be one number > 0 or one per turn ({len(self.turns)}), "
+                             f"got {self.revolutions!r}")
         if not self.turns:
             raise InputError("turns is empty; give at least one of +x, -x, +y, -y, +z, -z")
         object.__setattr__(self, "turns", tuple(self.turns))
@@ -105,6 +120,9 @@ class ServoProtocol:
         if np.any(~(waits >= 0)):
             raise InputError(f"wait must be >= 0 s, got {self.wait!r}")
         positive("vibration_freq", self.vibration_freq)
+        positive("ripple_freq", self.ripple_freq)
+        if not 0 <= self.ripple <= 0.5:
+            raise InputError(f"ripple must be in [0, 0.5] (a fraction of the speed), got {self.ripple!r}")
         if not 0 <= self.misalignment_deg <= 10:
             raise InputError(f"misalignment_deg must be in [0, 10] deg, got {self.misalignment_deg!r}")
         if not 0 <= self.unevenness <= 0.9:
@@ -141,8 +159,13 @@ class ServoProtocol:
 
     @property
     def turn_angle(self) -> float:
-        """Angle of every turn [rad]."""
-        return 2.0 * math.pi * self.revolutions
+        """Angle of every turn [rad] (of the first, when they differ)."""
+        return float(self.turn_angles()[0])
+
+    def turn_angles(self) -> np.ndarray:
+        """Angle of each turn [rad]."""
+        revs = np.atleast_1d(np.asarray(self.revolutions, dtype=float))
+        return 2.0 * math.pi * np.broadcast_to(revs, (len(self.turns),))
 
 
 @dataclass(frozen=True)
@@ -184,6 +207,19 @@ def _trapezoid_angle(t: np.ndarray, speed: float, ramp: float, total: float) -> 
     return np.where(tc < ramp, up, np.where(tc > duration - ramp, down, mid)), duration
 
 
+def _ripple_angle(t: np.ndarray, p: ServoProtocol, ramp: float, duration: float, rng) -> np.ndarray:
+    """Angle error [rad] of a speed ripple at times `t`, zero at both ends of the piece.
+
+    The speed ripple ``ripple * speed * cos(2 pi f t + phase)`` integrates to a sinusoidal angle
+    error; it fades in over the ramp (half a ripple period without one) so the end angle is exact
+    and the plateau carries the full ripple.
+    """
+    f = p.ripple_freq
+    edge = ramp if ramp > 0 else 0.5 / f
+    fade = np.clip(np.minimum(t, duration - t) / edge, 0.0, 1.0)
+    return fade * p.ripple * p.speed / (2 * np.pi * f) * np.sin(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi))
+
+
 def _piece(p: ServoProtocol, total: float, fs: float, rng: np.random.Generator) -> tuple[np.ndarray, int, int]:
     """Rates of one turn piece [rad/s] (sign +), and the sample span of its plateau."""
     ramp = min(p.ramp, total / p.speed)  # a short piece never reaches a plateau longer than itself
@@ -204,6 +240,8 @@ def _piece(p: ServoProtocol, total: float, fs: float, rng: np.random.Generator) 
             2 * np.pi * p.vibration_freq * tb + rng.uniform(0, 2 * np.pi))
         random = p.vibration * p.speed / (2.0 * fs) * rng.standard_normal(n + 1)
         angle = angle + taper * (periodic + random)
+    if p.ripple > 0:
+        angle = angle + _ripple_angle(np.arange(n + 1) / fs, p, ramp, duration, rng)
     rates = np.diff(angle) * fs
     lo, hi = int(math.ceil(ramp * fs)), int(math.floor((duration - ramp) * fs))
     return rates, lo, max(hi, lo)
@@ -264,11 +302,11 @@ def simulate_servo(
     static(p.lead_in)
     waits = p.waits()
     pieces = int(p.pauses) + 1
-    for i, (turn, (axis, sign)) in enumerate(zip(p.turns, p._parsed)):
+    for i, (turn, (axis, sign), total) in enumerate(zip(p.turns, p._parsed, p.turn_angles().tolist())):
         start = pos
         parts = []
         for j in range(pieces):
-            rates, lo, hi = _piece(p, p.turn_angle / pieces, fs, rng)
+            rates, lo, hi = _piece(p, total / pieces, fs, rng)
             if pieces == 1 and p.unevenness == 0 and hi - lo >= 2:
                 plateaus.append(Window(pos + lo, pos + hi, "rotation", "xyz"[axis], sign, p.speed * (hi - lo) / fs,
                                        p.speed, label=turn))
@@ -280,8 +318,8 @@ def simulate_servo(
                 pos += n_pause
         scalar = np.concatenate(parts)
         chunks.append(np.outer(sign * scalar, mounting[:, axis]))
-        windows.append(Window(start, pos, "rotation", "xyz"[axis], sign, p.turn_angle,
-                              p.turn_angle * fs / (pos - start), label=turn))
+        windows.append(Window(start, pos, "rotation", "xyz"[axis], sign, total, total * fs / (pos - start),
+                              label=turn))
         if i < len(waits):
             static(waits[i])
     static(p.lead_out)

@@ -40,8 +40,8 @@ from ..choices import OutOfRange, TableModel, values
 from ..errors import FileFormatError, InputError, UnitError
 from ..files import register
 from ..models import KG_NAMES, kg_to_kb
-from ..sections import FitQuality, section
 from ..recording import Recording
+from ..sections import FitQuality, section
 from ..units import RateUnit, parse_rate_unit, unit_factor
 from .lagrange import check_nodes, interpolate, range_policy
 from .smooth import SmoothModel

@@ -1,0 +1,236 @@
+"""``gyrocal capture``: record a live stream from a device, optionally guided, and check the device's answer."""
+
+from __future__ import annotations
+
+import math
+import queue
+import signal
+import sys
+import threading
+import time
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from ..choices import CaptureWire, GuideName, InputUnit
+from ..errors import GyrocalError, InputError
+from ._outputs import check_output
+from .app import app, console, warn
+
+
+class _Stop:
+    """SIGINT and SIGTERM set a flag the capture loop reads after each read: no byte read is dropped."""
+
+    def __init__(self):
+        self.requested = False
+        self._old = {}
+
+    def __enter__(self):
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            self._old[sig] = signal.signal(sig, self._handle)
+        return self
+
+    def _handle(self, signum, frame):
+        self.requested = True
+
+    def __exit__(self, *exc):
+        for sig, old in self._old.items():
+            signal.signal(sig, old)
+
+    def __call__(self) -> bool:
+        return self.requested
+
+
+class _Progress:
+    """One status line on stderr: redrawn in place on a terminal, every 10 s otherwise."""
+
+    def __init__(self, quiet: bool):
+        self.tty = sys.stderr.isatty()
+        self.quiet = quiet
+        self.last = 0.0
+
+    def show(self, line: str) -> None:
+        if self.quiet:
+            return
+        now = time.monotonic()
+        if self.tty:
+            sys.stderr.write("\r\x1b[K" + line)
+            sys.stderr.flush()
+        elif now - self.last >= 10.0:
+            sys.stderr.write(line + "\n")
+            self.last = now
+
+    def clear(self) -> None:
+        if self.tty and not self.quiet:
+            sys.stderr.write("\r\x1b[K")
+
+
+def _say(progress: _Progress, text: str) -> None:
+    progress.clear()
+    console.print(text, highlight=False, soft_wrap=True, markup=False)
+
+
+def _keys(commands: queue.Queue) -> None:
+    """Read the person's commands from stdin: 'r' redoes the last step, 'q' stops."""
+    for line in sys.stdin:
+        commands.put(line.strip().lower()[:1])
+
+
+class _Guided:
+    """Runs the guide on the samples as they arrive and prints what it says."""
+
+    def __init__(self, name: str, speed_rad, units: str, sensitivity, sample_rate, progress: _Progress, stop: _Stop):
+        from ..capture.guide import Guide
+
+        self.guide = Guide(name, speed=speed_rad)
+        self.units, self.sensitivity, self.sample_rate = units, sensitivity, sample_rate
+        self.progress, self.stop = progress, stop
+        self.commands: queue.Queue = queue.Queue()
+        self.started = False
+        threading.Thread(target=_keys, args=(self.commands,), daemon=True).start()
+
+    def _events(self, events) -> None:
+        for e in events:
+            mark = {"accepted": "ok: ", "refused": "NO: ", "redo": "redo: "}.get(e.kind, "")
+            _say(self.progress, f"guide: {mark}{e.text}")
+
+    def __call__(self, cap) -> bool:
+        if not self.started:
+            self.started = True
+            _say(self.progress, "guide: type r + Enter to redo the last step, q + Enter to stop")
+            self._events(self.guide.start())
+        store = cap.result.store
+        sens = self.sensitivity or (cap.result.hello.sensitivity if cap.result.hello else None)
+        while not self.commands.empty():
+            key = self.commands.get()
+            if key == "r":
+                self._events(self.guide.redo(len(store)))
+            elif key == "q":
+                self.stop.requested = True
+        if len(store) < 2:
+            return False
+        if self.units == "counts" and sens is None:
+            raise InputError("the guide needs the sensitivity to check the turns' angles (the device's hello frame "
+                             "carries it)", param="sensitivity", hint="for text lines in counts give {param} LSB")
+        self.sensitivity = sens
+        self._events(self.guide.update(store.recording(self.units, sens, self.sample_rate)))
+        return self.guide.complete
+
+
+def _on_event(progress: _Progress, unit: str):
+    from ..capture.report import device_turn_line, progress_line
+
+    def handle(kind: str, payload) -> None:
+        if kind == "open":
+            _say(progress, f"listening on {payload}; Ctrl-C ends the capture and keeps everything received")
+        elif kind == "progress":
+            progress.show(progress_line(payload, unit))
+        elif kind == "hello":
+            _say(progress, f"device: {payload.firmware or '?'}, {payload.sample_rate:g} Hz, sensitivity "
+                           f"{payload.sensitivity:g} counts per {payload.rate_unit}")
+        elif kind == "wire":
+            _say(progress, f"receiving {payload}")
+        elif kind == "turn":
+            _say(progress, device_turn_line(payload))
+        elif kind == "result":
+            _say(progress, f"device: calibration {payload.status_name}" + (
+                "" if payload.status else f": k {', '.join(f'{v:.6g}' for v in payload.k)} [deg/s per count], "
+                f"b {', '.join(f'{v:.5g}' for v in payload.b)} [counts]"))
+        elif kind == "message":
+            _say(progress, f"device: {payload}")
+        elif kind == "stall":
+            progress.clear()
+            warn(f"no data for {payload:.1f} s (the device stalled, or the cable?); still listening")
+        elif kind == "resumed":
+            _say(progress, f"data again after {payload:.1f} s")
+
+    return handle
+
+
+@app.command()
+def capture(
+    port: Annotated[str, typer.Option("--port", help="Serial port: /dev/ttyACM0, COM3, a pseudo-terminal, "
+                                      "socket://HOST:PORT (anything pyserial opens).")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Recording to write (CSV: t, gx, gy, gz[, temp]).")],
+    baud: Annotated[int, typer.Option("--baud", help="Baud rate [bit/s].")] = 115200,
+    wire: Annotated[CaptureWire, typer.Option("--wire", help="Wire format: auto, frames (gyrocal frames) or text "
+                                      "(lines such as t,gx,gy,gz).")] = "auto",
+    columns: Annotated[str | None, typer.Option("--columns", help="Text lines without a header: column "
+                                                   "numbers from 1, e.g. t=1,gx=2,gy=3,gz=4 (default: the header's names).")] = None,
+    units: Annotated[InputUnit, typer.Option("--units", help="Unit of the rates received: counts, deg/s or rad/s "
+                                       "(frames always send counts).")] = "counts",
+    sensitivity: Annotated[float | None, typer.Option("--sensitivity", help="Counts per deg/s (frames: the "
+                                                         "device says) (default: none; counts are kept).")] = None,
+    sample_rate: Annotated[float | None, typer.Option("--sample-rate", help="[Hz], for text lines without "
+                                                         "a time column (default: from the time column).")] = None,
+    duration: Annotated[float | None, typer.Option("--duration", help="Stop after S seconds of data (default: no limit).")] = None,
+    samples: Annotated[int | None, typer.Option("--samples", help="Stop after N samples (default: no limit).")] = None,
+    silence: Annotated[float | None, typer.Option("--silence", help="Stop after S seconds without a "
+                                                     "byte (default: no limit).")] = None,
+    guide: Annotated[GuideName | None, typer.Option("--guide", help="Guided session: servo (the six turns of the "
+                                                 "servo method of Wang et al.) or hand (default: none, plain recording).")] = None,
+    speed: Annotated[float | None, typer.Option("--speed", help="Known turn speed [deg/s] (servo); default "
+                                                   "whole 360 deg turns at any speed.")] = None,
+    calibration: Annotated[Path | None, typer.Option("--cal", help="Calibration file to write when the "
+                                                        "guide completes (default: beside -o, .cal.json).")] = None,
+    force: Annotated[bool, typer.Option("--force", help="Replace existing output files.")] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", help="No progress line.")] = False,
+) -> None:
+    """Record a live stream from a serial port; with --guide, walk through a calibration and calibrate."""
+    from ..capture.recorder import Capture
+
+    if columns:
+        from ..io.columns import parse_columns
+
+        columns = parse_columns(columns)
+    check_output(output, force=force, holds="another file (a recording?)")
+    cal_path = calibration or (output.with_suffix(".cal.json") if guide else None)
+    if guide:
+        check_output(cal_path, flag="--cal", inputs=(output,), force=force, holds="another file")
+    progress = _Progress(quiet)
+    with _Stop() as stop:
+        speed_rad = None if speed is None else math.radians(speed)
+        guided = None if guide is None else _Guided(guide, speed_rad, units, sensitivity, sample_rate, progress, stop)
+        cap = Capture(port, output, baud=baud, wire=wire, columns=columns, duration=duration, samples=samples,
+                      silence=silence, on_event=_on_event(progress, units))
+        result = cap.run(stop=stop, each=guided)
+    progress.clear()
+    _finish(result, port, units, sensitivity, sample_rate, guided, cal_path, speed_rad)
+
+
+def _finish(result, port, units, sensitivity, sample_rate, guided, cal_path, speed_rad) -> None:
+    from ..capture.report import calibrate_capture, device_check, host_versus_device, summary
+
+    if result.path is None:
+        raise InputError(f"no samples received from {port}: check the baud rate (--baud), the wire format (--wire) "
+                         "and, for text lines, the header or --columns")
+    for line in summary(result):
+        console.print(line, highlight=False, soft_wrap=True, markup=False)
+    sens = sensitivity or (result.hello.sensitivity if result.hello else None)
+    calibrate_args = {"units": units, "sensitivity": sens, "sample_rate": sample_rate}
+    if guided is not None and guided.guide.complete:
+        run = calibrate_capture(result.path, windows=guided.guide.windows(), speed=speed_rad, **calibrate_args)
+        from ..files import save
+
+        save(run.calibration, cal_path)
+        console.print(run.report(), highlight=False, soft_wrap=True, markup=False)
+        console.print(f"wrote {cal_path}", highlight=False, markup=False)
+    elif guided is not None:
+        warn(f"the guided session stopped at step {guided.guide.index + 1} of {len(guided.guide.steps)}; "
+             "no calibration written (the recording is complete)")
+    agreement = device_check(result)
+    if agreement is None:
+        return
+    console.print(agreement.report(), highlight=False, soft_wrap=True, markup=False)
+    if not agreement.agrees:
+        warn("the device's calibration differs from the host's recomputation beyond float32 rounding: "
+             "the firmware does not compute what the gyrocal C library computes on these samples")
+    if sens is not None and units == "counts":
+        try:
+            run = calibrate_capture(result.path, speed=speed_rad, **calibrate_args)
+        except GyrocalError as exc:  # the host's own segmentation found too little: say so, the recording stands
+            warn(f"the host could not calibrate the recording itself: {exc}")
+            return
+        for line in host_versus_device(run, agreement, sens):
+            console.print(line, highlight=False, soft_wrap=True, markup=False)

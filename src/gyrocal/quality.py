@@ -1,0 +1,150 @@
+"""Goodness of fit: do the windows agree with the model within their noise?
+
+Every fit leaves residuals: a turn's mean rate against its reference, a static window's mean
+against the bias. In noise units (each divided by its own predicted standard deviation) their
+sum of squares is chi-squared with ``rows - parameters`` degrees of freedom when the model and
+the noise are right. A p-value below 0.001 says they are not: the covariance built from the
+noise alone is then too small, and it is scaled by chi^2 / dof (the Birge ratio squared, as
+metrology and particle-physics averages do), with a warning that names the windows that
+disagree most. With no degrees of freedom left the fit cannot check itself, and says so.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["P_THRESHOLD", "GoodnessOfFit", "assess_fit"]
+
+#: Below this p-value the windows disagree beyond their noise and the covariance is scaled.
+P_THRESHOLD = 1e-3
+_NAMED = 3  # windows named in a warning
+
+
+@dataclass(frozen=True)
+class GoodnessOfFit:
+    """How well the windows agree with the fitted model.
+
+    Attributes
+    ----------
+    chi2 : float
+        Sum of squared residuals in noise units.
+    dof : int
+        Degrees of freedom: residual rows minus parameters (0: nothing to check).
+    p_value : float or None
+        Probability of a chi2 at least this large if the model and noise were right; None
+        without degrees of freedom.
+    birge_ratio : float or None
+        ``sqrt(chi2 / dof)``; None without degrees of freedom.
+    covariance_scaled : bool
+        Whether the reported covariance was multiplied by ``birge_ratio**2``.
+    labels : tuple of str
+        One name per window, in the order of the calibration's windows.
+    residuals : tuple of tuple of float
+        Each window's residuals in noise units: one for a rotation, three (x, y, z) for a static window.
+    disagree : tuple of int
+        Windows that disagree most (largest share of chi2), when the fit is flagged.
+    warnings : tuple of str
+        Lines for people (the command line prints each as ``warning: ...``).
+    """
+
+    chi2: float
+    dof: int
+    p_value: float | None
+    birge_ratio: float | None
+    covariance_scaled: bool
+    labels: tuple[str, ...]
+    residuals: tuple[tuple[float, ...], ...]
+    disagree: tuple[int, ...] = ()
+    warnings: tuple[str, ...] = ()
+
+    @property
+    def chi2_per_dof(self) -> float | None:
+        return self.chi2 / self.dof if self.dof > 0 else None
+
+    def summary(self) -> str:
+        """One line: chi2/dof, p-value and what was done."""
+        if self.dof == 0:
+            return f"fit quality: chi2 {self.chi2:.3g} with no residual degrees of freedom (nothing to check)"
+        text = (f"fit quality: chi2/dof {self.chi2:.4g}/{self.dof} = {self.chi2 / self.dof:.3g}, "
+                f"p = {self.p_value:.3g}")
+        if self.covariance_scaled:
+            text += f"; 1-sigma scaled by the Birge ratio {self.birge_ratio:.3g}"
+        return text
+
+    def to_document(self) -> dict:
+        """JSON-ready record (the calibration file's ``fit`` section)."""
+        return {
+            "chi2": self.chi2,
+            "dof": self.dof,
+            "chi2_per_dof": self.chi2_per_dof,
+            "p_value": self.p_value,
+            "birge_ratio": self.birge_ratio,
+            "covariance_scaled": self.covariance_scaled,
+            "residuals": [{"window": i, "label": lab, "z": list(z)}
+                          for i, (lab, z) in enumerate(zip(self.labels, self.residuals))],
+            "disagree": list(self.disagree),
+            "warnings": list(self.warnings),
+        }
+
+    @classmethod
+    def from_document(cls, doc: dict) -> GoodnessOfFit:
+        """Inverse of :meth:`to_document`."""
+        res = doc.get("residuals") or []
+        return cls(
+            chi2=float(doc["chi2"]), dof=int(doc["dof"]),
+            p_value=None if doc.get("p_value") is None else float(doc["p_value"]),
+            birge_ratio=None if doc.get("birge_ratio") is None else float(doc["birge_ratio"]),
+            covariance_scaled=bool(doc.get("covariance_scaled", False)),
+            labels=tuple(str(r.get("label", "")) for r in res),
+            residuals=tuple(tuple(float(v) for v in r["z"]) for r in res),
+            disagree=tuple(int(i) for i in doc.get("disagree", ())),
+            warnings=tuple(str(w) for w in doc.get("warnings", ())),
+        )
+
+
+def _name(i: int, label: str, z: Sequence[float]) -> str:
+    size = float(np.sqrt(np.sum(np.square(z))))
+    return f"window {i} ({label}, {size:.3g} sigma)"
+
+
+def assess_fit(residuals: Sequence[Sequence[float]], labels: Sequence[str], n_params: int, *,
+               what: str = "the windows") -> GoodnessOfFit:
+    """Goodness of fit from per-window residuals in noise units.
+
+    Parameters
+    ----------
+    residuals : sequence of sequences of float
+        Each window's residuals divided by their predicted standard deviation.
+    labels : sequence of str
+        Window names, for the warning.
+    n_params : int
+        Parameters fitted.
+    what : str
+        What the rows are, for the messages.
+    """
+    from scipy.stats import chi2 as chi2_dist
+
+    z = [np.asarray(r, dtype=float).ravel() for r in residuals]
+    per_window = np.array([float(np.dot(r, r)) for r in z])
+    chi2 = float(per_window.sum())
+    rows = sum(len(r) for r in z)
+    dof = rows - n_params
+    zs = tuple(tuple(float(v) for v in r) for r in z)
+    if dof <= 0:
+        note = (f"no residual degrees of freedom: {rows} equations for {n_params} parameters, so nothing checks "
+                f"{what} against each other; add static windows or repeat turns to let the fit check itself")
+        return GoodnessOfFit(chi2, 0, None, None, False, tuple(labels), zs, (), (note,))
+    p = float(chi2_dist.sf(chi2, dof))
+    birge = math.sqrt(chi2 / dof)
+    if p >= P_THRESHOLD:
+        return GoodnessOfFit(chi2, dof, p, birge, False, tuple(labels), zs)
+    worst = tuple(int(i) for i in np.argsort(-per_window)[:_NAMED])
+    names = ", ".join(_name(i, labels[i], z[i]) for i in worst)
+    warning = (f"{what} disagree beyond their noise: chi2/dof = {chi2 / dof:.3g} ({dof} dof, p = {p:.2g}); "
+               f"most: {names}; every 1-sigma is scaled by the Birge ratio {birge:.3g}. Check these windows "
+               "(declared angle or speed, a slipping mount, a drifting bias)")
+    return GoodnessOfFit(chi2, dof, p, birge, True, tuple(labels), zs, worst, (warning,))

@@ -1,0 +1,131 @@
+"""Windows a calibration must not use as they are: turns across a real gap, varying rates for the paper's methods.
+
+* A real gap (samples never delivered, see :mod:`gyrocal.timebase`) inside a whole turn hides
+  angle: the trapezoid across it is exact only if the rate was linear there. The angle it may
+  hide is bounded by the rates on either side; a turn keeps that bound as the uncertainty of its
+  angle when it is small (at most 1 % of the turn), and is left out otherwise, with the gap in
+  the reason. Plateau means (speed reference) and static means lose nothing but samples.
+* Algorithm 1 and LM (the servo method of Wang et al., eq. 4-8) average ``m^2`` and assume a
+  constant speed in every window; a window whose rate varies (ramps, a hand turn) reads k low by
+  about half its squared coefficient of variation. They refuse such windows and point to the
+  default method, which is exact on whole turns.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from .errors import InputError
+from .recording import Recording
+from .segmentation import Segmentation
+from .timebase import Gap, TimeBase
+from .windows import Window
+
+__all__ = ["MAX_GAP_SHARE", "MAX_RATE_CV", "rate_variation", "require_constant_rate", "screen_gaps"]
+
+#: Largest rate variation (sd / mean, noise removed) the paper's methods accept: k low by about 0.5 %.
+MAX_RATE_CV = 0.10
+#: A turn whose time-stamp gaps may hide more than this share of its angle is left out.
+MAX_GAP_SHARE = 0.01
+
+
+def _name(w: Window, i: int | None = None) -> str:
+    where = f"samples {w.start}:{w.stop}"
+    label = w.label or (f"{'+' if w.sign >= 0 else '-'}{w.axis}" if w.axis else w.kind)
+    return f"{'' if i is None else f'window {i} '}({label}, {where})"
+
+
+def _gap_bound(rec: Recording, t: np.ndarray, w: Window, gap: Gap, baseline: np.ndarray) -> tuple[float, float]:
+    """Bound on the angle a gap hides [reading units x s], and the turn's measured angle there.
+
+    The trapezoid across a gap takes the mean of the rates at its ends. The rate inside stays
+    between the rates seen one gap-length before and after (a turn's rate is continuous), so
+    the error is at most the gap's length times half their difference, plus three standard
+    errors of those means for the noise.
+    """
+    i = gap.index
+    length = float(t[i] - t[i - 1])
+    before = slice(max(w.start, int(np.searchsorted(t, t[i - 1] - length))), i)
+    after = slice(i, min(w.stop, max(i + 1, int(np.searchsorted(t, t[i] + length)))))
+    seg = rec.gyro[w.start:w.stop] - baseline
+    u = seg.mean(axis=0)
+    u = u / (np.linalg.norm(u) or 1.0)
+    rb = (rec.gyro[before] - baseline) @ u
+    ra = (rec.gyro[after] - baseline) @ u
+    d = np.diff(seg, axis=0) @ u
+    noise = math.sqrt(float(np.mean(d * d)) / 2.0) if len(d) else 0.0
+    spread = abs(float(ra.mean()) - float(rb.mean())) / 2 + 3 * noise * math.sqrt(1 / len(ra) + 1 / len(rb))
+    dt = np.diff(t[w.start:w.stop])[:, None]
+    return length * spread, float(np.linalg.norm(np.sum((seg[1:] + seg[:-1]) / 2 * dt, axis=0)))
+
+
+def screen_gaps(seg: Segmentation, rec: Recording, tb: TimeBase, reference: str, times: np.ndarray | None = None,
+                max_share: float = MAX_GAP_SHARE) -> tuple[Segmentation, dict[tuple[int, int], float]]:
+    """Turns (angle reference) across real gaps: kept with an angle uncertainty, or left out.
+
+    Returns the segmentation with the turns whose gaps may hide more than `max_share` of their
+    angle moved to ``ignored`` (with the reason), and for the others the relative variance of
+    their angle [1], keyed by ``(start, stop)``: the reference rate's variance is that times
+    the rate squared.
+    """
+    if reference != "angle" or not tb.gaps:
+        return seg, {}
+    kept, dropped, rel_var = [], [], {}
+    for w in seg.windows:
+        gaps = tb.gaps_in(w.start, w.stop) if w.kind == "rotation" else ()
+        if not gaps:
+            kept.append(w)
+            continue
+        bounds = [_gap_bound(rec, rec.t if times is None else times, w, g, seg.baseline) for g in gaps]
+        turned = bounds[0][1]
+        bound = math.sqrt(sum(b * b for b, _ in bounds))  # independent gaps
+        lost = sum(g.lost for g in gaps)
+        if turned > 0 and bound <= max_share * turned:
+            kept.append(w)
+            rel_var[(w.start, w.stop)] = (bound / turned) ** 2 / 3.0  # uniform within the bound
+            continue
+        worst = max(gaps, key=lambda g: g.step)
+        dropped.append((w, f"gap: {lost} sample(s) missing inside the turn ({worst.step * 1e3:.4g} ms step at sample "
+                           f"{worst.index}); the angle they hide may be {100 * bound / max(turned, 1e-300):.2g} % "
+                           f"of the turn (at most {100 * max_share:g} % is accepted)"))
+    return dataclasses.replace(seg, windows=tuple(kept), ignored=seg.ignored + tuple(dropped)), rel_var
+
+
+def rate_variation(samples: np.ndarray, baseline: np.ndarray) -> float:
+    """Coefficient of variation of a window's rate along its turn axis, white noise removed.
+
+    The rate is ``(m - baseline) . u`` with ``u`` the window's mean direction; its variance less
+    the noise variance along ``u`` (from first differences) over its squared mean. The paper's
+    mean of squares reads ``k`` low by about half its square.
+    """
+    d = np.asarray(samples, dtype=float) - baseline
+    mean = d.mean(axis=0)
+    speed = float(np.linalg.norm(mean))
+    if speed == 0:
+        return math.inf
+    u = mean / speed
+    s = d @ u
+    diff = np.diff(d, axis=0)
+    noise = float(np.mean((diff @ u) ** 2) / 2.0) if len(diff) else 0.0
+    return math.sqrt(max(float(s.var()) - noise, 0.0)) / speed
+
+
+def require_constant_rate(rec: Recording, windows: Sequence[Window], baseline: np.ndarray, method: str) -> None:
+    """Refuse, for the paper's methods, a rotation window whose rate varies more than `MAX_RATE_CV`."""
+    name = {"algorithm1": "Algorithm 1", "lm": "LM"}.get(method, method)
+    for i, w in enumerate(windows):
+        if w.kind != "rotation":
+            continue
+        cv = rate_variation(rec.gyro[w.start:w.stop], baseline)
+        if cv > MAX_RATE_CV:
+            raise InputError(
+                f"rotation window {_name(w, i)}: its rate varies {100 * cv:.0f} % (sd/mean, noise removed). "
+                f"{name} (the servo method of Wang et al., eq. 4-8) assumes a constant speed in every window and "
+                f"would read k low by about {50 * cv * cv:.2g} %", param="method", value=method,
+                hint="use the default method ({param} first-moment), which is exact on whole turns, or "
+                "constant-speed plateaus (a known speed)"
+            )

@@ -1,0 +1,283 @@
+"""The time base of a recording: nominal rate, jitter, delayed deliveries and real gaps.
+
+Logs stamped when a PC *receives* the samples come in bursts: the steps alternate short and
+long (for example 3 ms and 17 ms around a 10 ms sensor clock), and a late packet is a long
+step followed by a burst of short ones. The sensor clock stays regular under all this, so:
+
+* the nominal period is the mean step of the regular clock, found robustly as the median of
+  block-mean steps (a block of 64 steps averages bursts away; the median ignores the few
+  blocks that hold a gap), never the median of the single steps;
+* a long step is a **real gap** only when samples are missing: the clock residual
+  ``t_i - i P`` (its lower envelope, the least-delayed samples) jumps by at least half a
+  period across it and stays there. A delayed delivery makes the residual rise and fall
+  back within the burst, and loses nothing.
+
+Angles are then integrals on the actual stamps (trapezoid weights, see
+:func:`gyrocal.observations.observe`); a turn that straddles a real gap has lost angle that
+no stamp can give back.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import InputError
+
+__all__ = ["Gap", "TimeBase", "analyse_time", "nominal_period"]
+
+_BLOCK = 64  # steps per block of the robust period estimate
+_ENVELOPE = 50  # samples each side over which the clock residual's lower envelope is taken
+#: Steps below this multiple of the period cannot hide a lost sample and are not examined.
+_CANDIDATE_STEP = 1.5
+#: A step this many periods long that lost nothing is a late delivery (shorter ones are jitter).
+_LATE_STEP = 3.0
+
+
+def nominal_period(t: np.ndarray) -> float:
+    """Period of the sensor clock [s]: the median of block-mean steps of up to `_BLOCK` steps.
+
+    Equal to the mean step ``span / (N - 1)`` for a log without gaps, whatever its jitter,
+    and unaffected by a few gaps (they move only the blocks that hold them).
+    """
+    t = np.asarray(t, dtype=float)
+    n = len(t) - 1
+    if n < 1:
+        raise InputError(f"a time base needs at least two samples, got {len(t)}")
+    block = min(_BLOCK, max(1, n // 8))
+    if n < 2 * block:
+        return float(t[-1] - t[0]) / n
+    ends = t[::block]
+    return float(np.median(np.diff(ends))) / block
+
+
+@dataclass(frozen=True)
+class Gap:
+    """Samples missing from a log: the step ``t[index - 1] -> t[index]`` lost `lost` samples.
+
+    Attributes
+    ----------
+    index : int
+        First sample after the gap.
+    step : float
+        The long step [s].
+    lost : int
+        Samples missing, from the jump of the regular clock.
+    """
+
+    index: int
+    step: float
+    lost: int
+
+
+@dataclass(frozen=True)
+class TimeBase:
+    """Facts about a recording's time stamps.
+
+    Attributes
+    ----------
+    n : int
+        Samples.
+    span : float
+        ``t[-1] - t[0]`` [s].
+    period : float
+        Nominal period of the sensor clock [s] (:func:`nominal_period`).
+    mean_step, median_step : float
+        Mean and median of the single steps [s].
+    jitter : float
+        Standard deviation of the single steps, gaps left out [s].
+    delayed : int
+        Long steps (over 3 periods) that lost no sample: late deliveries caught up by a burst.
+    gaps : tuple of Gap
+        Real gaps (samples missing).
+    has_time : bool
+        Whether the stamps came from the data (False: built from a declared rate).
+    regular_clock : bool
+        Whether the stamps follow a regular sensor clock (with its gaps) up to bounded delays:
+        the lower envelope of ``t_i - i P`` stays within half a period of a straight line. Then
+        :meth:`clock_times` rebuilds the sample times on that clock.
+    clock_start, clock_period : float
+        The regular clock ``t = clock_start + clock_period x (sample number, gaps counted)`` [s].
+    """
+
+    n: int
+    span: float
+    period: float
+    mean_step: float
+    median_step: float
+    jitter: float
+    delayed: int
+    gaps: tuple[Gap, ...]
+    has_time: bool = True
+    regular_clock: bool = False
+    clock_start: float = 0.0
+    clock_period: float = 0.0
+
+    @property
+    def sample_rate(self) -> float:
+        """Nominal rate [Hz]: of the regular sensor clock when there is one, else of the block-mean steps."""
+        return 1.0 / (self.clock_period if self.regular_clock else self.period)
+
+    @property
+    def lost(self) -> int:
+        """Samples missing in all gaps."""
+        return sum(g.lost for g in self.gaps)
+
+    @property
+    def bursty(self) -> bool:
+        """Whether the single steps scatter by more than 10 % of the period (receive-time stamps)."""
+        return self.jitter > 0.1 * self.period
+
+    def clock_numbers(self) -> np.ndarray:
+        """Each sample's number on the sensor clock (N,): its index plus the samples lost before it."""
+        add = np.zeros(self.n)
+        for g in self.gaps:
+            add[g.index] += g.lost
+        return np.arange(self.n, dtype=float) + np.cumsum(add)
+
+    def clock_times(self) -> np.ndarray | None:
+        """Sample times [s] on the regular sensor clock, gaps included; None without a regular clock.
+
+        Receive-time stamps place a sample when it arrived, up to a late delivery's delay after it
+        was taken; during a ramp that misplaces rate. The sensor's own clock does not.
+        """
+        if not self.regular_clock:
+            return None
+        return self.clock_start + self.clock_period * self.clock_numbers()
+
+    def gaps_in(self, start: int, stop: int) -> tuple[Gap, ...]:
+        """Gaps between samples ``start`` and ``stop - 1`` (inside a window ``start:stop``)."""
+        return tuple(g for g in self.gaps if start < g.index < stop)
+
+    def to_document(self) -> dict:
+        """JSON-ready facts (the calibration file's ``observed.time_base``), times in seconds."""
+        return {"nominal_rate": self.sample_rate, "has_time": self.has_time, "mean_step": self.mean_step,
+                "median_step": self.median_step, "jitter": self.jitter, "late_deliveries": self.delayed,
+                "gaps": len(self.gaps), "lost_samples": self.lost, "regular_clock": self.regular_clock}
+
+    def describe(self) -> list[str]:
+        """Plain lines for people: rate, steps, jitter, delayed deliveries and gaps."""
+        ms = 1e3
+        if not self.has_time:
+            return [f"time base: no time column; {self.sample_rate:.6g} Hz as declared, {self.n} samples"]
+        jitter = f"{self.jitter * ms:.3g} ms" if self.jitter > 1e-6 * self.period else "none"
+        lines = [
+            f"time base: {self.sample_rate:.6g} Hz nominal (mean step of the sensor clock); "
+            f"steps mean {self.mean_step * ms:.4g} ms, median {self.median_step * ms:.4g} ms, jitter {jitter}"
+        ]
+        if self.bursty:
+            on = ("the sensor's regular clock rebuilt from them" if self.regular_clock else "the stamps")
+            lines.append(f"  steps are bursty (receive-time stamps?): angles are integrated on {on}, and the rate "
+                         "is the mean one, never the median step")
+        if self.delayed:
+            lines.append(f"  {self.delayed} late deliveries (a long step caught up by a burst; no sample lost)")
+        if self.gaps:
+            worst = max(self.gaps, key=lambda g: g.lost)
+            lines.append(f"  {len(self.gaps)} gap(s), {self.lost} sample(s) missing; longest {worst.step * ms:.4g} ms "
+                         f"at sample {worst.index} ({worst.lost} lost): turns across a gap are left out")
+        return lines
+
+
+def _envelope(r: np.ndarray, size: int, forward: bool) -> np.ndarray:
+    """Running minimum of `r` over the `size` samples from i on (forward) or up to i (backward)."""
+    from scipy.ndimage import minimum_filter1d
+
+    # minimum_filter1d centres its window; `origin` shifts it to one side
+    origin = -(size // 2) if forward else (size - 1) // 2
+    return minimum_filter1d(r, size, mode="nearest", origin=origin)
+
+
+def _floor(x: np.ndarray) -> float:
+    """A low quantile (the tenth) of `x`: the least-delayed level, unmoved by one late sample."""
+    k = len(x) // 10
+    return float(np.partition(x, k)[k])
+
+
+def _find_gaps(t: np.ndarray, step: np.ndarray, period: float) -> list[Gap]:
+    """Real gaps: long steps across which the lower envelope of the clock residual rises for good.
+
+    A vectorised pass keeps the long steps whose envelope rises by half a period. Each is then
+    confirmed by the least-delayed level (a low quantile, so that a few delayed samples at a
+    gap's edge do not count) just before and just after it, with the gaps already found taken
+    out: the longest steps first, then the shorter ones in time order, so that a burst's long
+    step right after a real gap is judged with that gap removed. A step must also be long
+    enough to hold the samples it lost.
+    """
+    candidates = np.flatnonzero(step > _CANDIDATE_STEP * period)
+    if not len(candidates):
+        return []
+    r = t - t[0] - period * np.arange(len(t))  # clock residual; its envelope is the least-delayed samples
+    size = min(_ENVELOPE, len(t))
+    jump = _envelope(r, size, forward=True)[candidates + 1] - _envelope(r, size, forward=False)[candidates]
+    likely = candidates[jump >= 0.5 * period]
+    long_first = likely[step[likely] >= _LATE_STEP * period]
+    order = np.concatenate([long_first[np.argsort(-step[long_first], kind="stable")],
+                            likely[step[likely] < _LATE_STEP * period]])
+    lost_at = np.zeros(len(t))  # samples lost just before each sample, as found so far
+    for i in order.tolist():
+        lo, hi = max(0, i - size + 1), min(len(t), i + 1 + size)
+        adj = r[lo:hi] - period * np.cumsum(lost_at[lo:hi])  # levels relative within the window
+        lost = int(np.rint((_floor(adj[i + 1 - lo:]) - _floor(adj[: i + 1 - lo])) / period))
+        if 1 <= lost <= int(np.rint(step[i] / period)):
+            lost_at[i + 1] = lost
+    found = np.flatnonzero(lost_at)
+    return [Gap(int(j), float(step[j - 1]), int(lost_at[j])) for j in found]
+
+
+def analyse_time(t, *, has_time: bool = True) -> TimeBase:
+    """Read the time base of stamps `t` [s] (strictly increasing).
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+        Sample times [s].
+    has_time : bool
+        Whether the stamps came from the data; a time base built from a declared rate is
+        regular but may still hold gaps (rows dropped for saturation).
+    """
+    t = np.asarray(t, dtype=float)
+    if t.ndim != 1 or len(t) < 2:
+        raise InputError(f"a time base needs at least two sample times, got shape {t.shape}")
+    step = np.diff(t)
+    period = nominal_period(t)
+    gaps = _find_gaps(t, step, period)
+    regular = np.ones(len(step), dtype=bool)
+    regular[[g.index - 1 for g in gaps]] = False
+    kept = step[regular] if regular.any() else step
+    base = TimeBase(len(t), float(t[-1] - t[0]), period, 0.0, 0.0, 0.0, 0, tuple(gaps))
+    clock = _fit_clock(t, base.clock_numbers(), period)
+    sample = kept[np.linspace(0, len(kept) - 1, min(len(kept), 100_000)).astype(np.intp)]
+    return TimeBase(
+        n=len(t),
+        span=float(t[-1] - t[0]),
+        period=period,
+        mean_step=float(step.mean()),
+        median_step=float(np.median(sample)),
+        jitter=float(kept.std()) if len(kept) > 1 else 0.0,
+        delayed=int(np.count_nonzero(step > _LATE_STEP * period)) - sum(g.step > _LATE_STEP * period for g in gaps),
+        gaps=tuple(gaps),
+        has_time=has_time,
+        regular_clock=clock is not None,
+        clock_start=clock[0] if clock else float(t[0]),
+        clock_period=clock[1] if clock else period,
+    )
+
+
+def _fit_clock(t: np.ndarray, k: np.ndarray, period: float) -> tuple[float, float] | None:
+    """``(start, period)`` of the regular clock under stamps `t` at clock numbers `k`, or None.
+
+    The lower envelope of ``t - k P`` (the least-delayed samples) is fitted by a line; the clock
+    is regular when the envelope stays within half a period of it.
+    """
+    from scipy.ndimage import minimum_filter1d
+
+    r = t - t[0] - period * k
+    env = minimum_filter1d(r, min(_ENVELOPE, len(t)), mode="nearest")
+    pick = np.linspace(0, len(t) - 1, min(len(t), 10_000)).astype(np.intp)
+    slope, icept = np.polyfit(k[pick], env[pick], 1)
+    resid = env - (icept + slope * k)
+    if float(resid.max() - resid.min()) >= 0.5 * period:
+        return None
+    return float(t[0] + icept), float(period + slope)
+

@@ -1,0 +1,220 @@
+"""``gyrocal capture`` as a user runs it: the installed entry point in a subprocess, on a virtual device.
+
+Independent references: the simulated session the virtual device sends (its samples and the true
+gyro), and, for the signal cases, exactly the frames sent before the device paused. The tests
+synchronise on what the command prints ("listening on ..." once the port is open, the guide's
+lines) and on the device having been read dry, never on sleeps; every wait has a generous timeout.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import queue
+import signal
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+from cli_runner import refused
+
+from gyrocal.capture import frames as fr
+from gyrocal.capture.device import Faults, VirtualDevice, device_bytes
+from gyrocal.capture.simulated import simulate_device_session
+from gyrocal.io import read_recording
+from gyrocal.models import ScaleBias
+from gyrocal.simulation import ServoProtocol
+
+GYROCAL = str(Path(sys.executable).with_name("gyrocal"))
+WAIT = 120.0  # [s] generous: a loaded 2-core machine
+MODEL = ScaleBias(k=np.array([1.02, 0.98, 1.01]), b=np.radians([1.5, -2.0, 0.8]))
+HELLO = len(fr.encode(fr.Hello(200.0, 131.0)))
+FRAME = fr.OVERHEAD + fr.Sample.FORMAT.size
+
+
+class Running:
+    """A ``gyrocal capture`` subprocess whose output lines can be waited for."""
+
+    def __init__(self, *args):
+        env = {**os.environ, "PYTHONUNBUFFERED": "1", "COLUMNS": "200"}
+        self.proc = subprocess.Popen([GYROCAL, "capture", *map(str, args)], stdin=subprocess.PIPE,
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+        self.lines: queue.Queue = queue.Queue()
+        self.seen: list[str] = []
+        self.err: list[str] = []
+        self._threads = [threading.Thread(target=self._pump, daemon=True),
+                         threading.Thread(target=lambda: self.err.extend(self.proc.stderr), daemon=True)]
+        for t in self._threads:
+            t.start()
+
+    def _pump(self):
+        for line in self.proc.stdout:
+            self.lines.put(line.rstrip("\n"))
+        self.lines.put(None)
+
+    def wait_for(self, text: str) -> str:
+        while True:
+            line = self.lines.get(timeout=WAIT)
+            assert line is not None, f"capture ended before printing {text!r}: {self.seen}"
+            self.seen.append(line)
+            if text in line:
+                return line
+
+    def finish(self) -> tuple[int, str, str]:
+        self.proc.stdin.close()
+        self.proc.wait(timeout=WAIT)
+        for t in self._threads:
+            t.join(WAIT)
+        self.proc.stdout.close()
+        self.proc.stderr.close()
+        rest = []
+        while not self.lines.empty():
+            line = self.lines.get()
+            if line is not None:
+                rest.append(line)
+        return self.proc.returncode, "\n".join(self.seen + rest), "".join(self.err)
+
+
+def start(dev: VirtualDevice, *args) -> Running:
+    port = dev.start()
+    run = Running("--port", port, *args)
+    run.wait_for("listening on")
+    dev.release()
+    return run
+
+
+@pytest.fixture(scope="module")
+def servo():
+    rng = np.random.default_rng(1601)
+    wrong = ServoProtocol(turns=("+x",), revolutions=0.75, lead_in=3.0, lead_out=1.0)
+    return simulate_device_session([wrong, ServoProtocol(lead_in=1.0)], model=MODEL, noise_std=0.01, rng=rng)
+
+
+def within_4_sigma(cal_path: Path) -> np.ndarray:
+    doc = json.loads(cal_path.read_text())
+    p = doc["parameters"]
+    params = np.r_[p[next(iter(p))]["k"], p[next(iter(p))]["b"]]
+    sd = np.sqrt(np.diag(doc["covariance"]))
+    z = (params - MODEL.params) / sd
+    assert np.all(np.abs(z) <= 4), z
+    return z
+
+
+def test_guided_servo_session_with_the_device_answer(tmp_path, servo):
+    out = tmp_path / "rec.csv"
+    with VirtualDevice(device_bytes(servo, "frames", encoder="c")) as dev:
+        run = start(dev, "-o", out, "--guide", "servo")
+        code, stdout, err = run.finish()
+    assert code == 0, err
+    assert "NO: +x: refused: wrong angle" in stdout and "every step accepted" in stdout
+    assert "device and host agree to float32 precision" in stdout
+    rec = read_recording(out, units="counts")
+    np.testing.assert_array_equal(rec.gyro, servo.raw[: len(rec)])  # the file holds what was sent, in order
+    within_4_sigma(out.with_suffix(".cal.json"))
+
+
+def test_guided_hand_session_with_a_redo(tmp_path):
+    rng = np.random.default_rng(1602)
+    proto = ServoProtocol.hand(turns=("+x", "+y", "+y", "+z"), lead_in=3.0, wait=3.0, lead_out=3.0)
+    s = simulate_device_session(proto, model=MODEL, noise_std=0.01, rng=rng)
+    data = device_bytes(s, "frames", encoder="python")
+    pause = s.turns[1].stop + int(2.0 * s.sample_rate)  # 2 s into the stillness after the first +y
+    with VirtualDevice(data, faults=Faults(stall_at=(HELLO + pause * FRAME) / len(data), stall_s=WAIT)) as dev:
+        run = start(dev, "-o", tmp_path / "rec.csv", "--guide", "hand")
+        run.wait_for("ok: +y: accepted")
+        run.proc.stdin.write("r\n")
+        run.proc.stdin.flush()
+        run.wait_for("redo step 4")
+        dev.resume()
+        code, stdout, err = run.finish()
+    assert code == 0, err
+    assert [ln.split(": ")[2] for ln in stdout.splitlines() if ln.startswith("guide: ok:")] == [
+        "still for 2 s", "+x", "still for 2 s", "+y", "+y", "still for 2 s", "+z", "still for 2 s"]
+    within_4_sigma(tmp_path / "rec.cal.json")
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_signal_ends_the_capture_with_everything_received(tmp_path, servo, sig):
+    data = device_bytes(servo, "frames", encoder="python")
+    pause = 0.5
+    with VirtualDevice(data, faults=Faults(stall_at=pause, stall_s=WAIT)) as dev:
+        run = start(dev, "-o", tmp_path / "rec.csv")
+        assert dev.paused.wait(WAIT)  # the capture has read every byte sent before the pause
+        run.proc.send_signal(sig)
+        code, stdout, err = run.finish()
+    assert code == 0, err
+    assert "capture ended (stopped)" in stdout
+    whole = (int(pause * len(data)) - HELLO) // FRAME
+    rec = read_recording(tmp_path / "rec.csv", units="counts")
+    np.testing.assert_array_equal(rec.gyro, servo.raw[:whole])
+    assert not list(tmp_path.glob(".*.part"))  # no temporary file left behind
+
+
+def test_disconnect_through_the_cli(tmp_path, servo):
+    data = device_bytes(servo, "text")
+    with VirtualDevice(data, faults=Faults(disconnect_at=0.3)) as dev:
+        run = start(dev, "-o", tmp_path / "rec.csv", "--samples", 100_000)
+        code, stdout, err = run.finish()
+    assert code == 0, err
+    assert "capture ended (end of stream)" in stdout
+    lines = data[: int(0.3 * len(data))].split(b"\r\n")[1:-1]  # complete lines after the header
+    rec = read_recording(tmp_path / "rec.csv", units="counts")
+    np.testing.assert_array_equal(rec.gyro, servo.raw[: len(lines)])
+
+
+def test_refusals_are_one_line(tmp_path):
+    assert "cannot open" in refused("capture", "--port", tmp_path / "no-such-port", "-o", tmp_path / "r.csv")
+    (tmp_path / "r.csv").write_text("keep me")
+    assert "--force" in refused("capture", "--port", "x", "-o", tmp_path / "r.csv")
+    assert (tmp_path / "r.csv").read_text() == "keep me"
+    assert "--wire" in refused("capture", "--port", "x", "-o", tmp_path / "s.csv", "--wire", "morse")
+
+
+def test_nothing_received_is_an_error_and_writes_nothing(tmp_path):
+    with VirtualDevice(b"") as dev:
+        code, _out, err = start(dev, "-o", tmp_path / "r.csv").finish()
+    assert code == 2 and "no samples received" in err
+    assert not (tmp_path / "r.csv").exists() and not list(tmp_path.glob(".*"))
+
+
+def test_guide_without_a_sensitivity_is_refused_but_keeps_the_recording(tmp_path, servo):
+    with VirtualDevice(device_bytes(servo, "text")) as dev:
+        run = start(dev, "-o", tmp_path / "r.csv", "--guide", "servo")
+        code, _out, err = run.finish()
+    assert code == 2 and "--sensitivity" in err and "Traceback" not in err
+    rec = read_recording(tmp_path / "r.csv", units="counts")
+    np.testing.assert_array_equal(rec.gyro, servo.raw[: len(rec)])
+    assert math.isfinite(rec.t[-1])
+
+
+def test_simulate_device_serves_capture(tmp_path):
+    """Two real processes, as a person would run them: the virtual device and the capture.
+
+    The device starts sending when it sees the port opened, so this test asserts only what
+    holds even if the capture missed the first bytes: a valid recording, the end of the
+    stream, and the device's calibration matching the host's recomputation.
+    """
+    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+    sim = subprocess.Popen([GYROCAL, "simulate", "--device", "--pace", "0", "--seed", "3", "--misalignment", "2"],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        first = sim.stdout.readline()
+        port = first.split(" on ")[1].split(":")[0]
+        cap = subprocess.run([GYROCAL, "capture", "--port", port, "-o", tmp_path / "rec.csv"], capture_output=True,
+                             text=True, timeout=WAIT, env=env)
+        sim_out, sim_err = sim.communicate(timeout=WAIT)
+    finally:
+        sim.kill()
+    assert cap.returncode == 0 and sim.returncode == 0, (cap.stderr, sim_err)
+    assert "capture ended (end of stream)" in cap.stdout and "the device closed the link" in sim_out
+    assert "device and host agree to float32 precision" in cap.stdout
+    assert len(read_recording(tmp_path / "rec.csv", units="counts")) > 10_000
+
+
+def test_simulate_device_flags_need_device(tmp_path):
+    assert "--device" in refused("simulate", "-o", tmp_path / "r.csv", "--faults", "drop=0.1")
+    assert "not understood" in refused("simulate", "--device", "--faults", "melt=1")

@@ -1,0 +1,224 @@
+"""Calibrations that check themselves: each defect of real recordings, simulated with its truth.
+
+Every test simulates one defect (bursty receive-time stamps, packet gaps, a wrong declared angle or
+sample rate, speed ripple, a poor gyro, ramps under the paper's methods, slow turns at 20 Hz) and
+checks the result against the simulator's truth: right within the reported 1-sigma, or flagged.
+Monte Carlo tolerances come from the spread of a z-score RMS over M draws of three scale factors,
+``sd(RMS) ~ 1 / sqrt(6 M)`` for unit normal z-scores.
+"""
+
+import dataclasses
+import math
+import re
+
+import numpy as np
+import pytest
+
+from gyrocal.errors import InputError, SegmentationError
+from gyrocal.models import ScaleBias
+from gyrocal.pipeline import calibrate
+from gyrocal.quality import GoodnessOfFit
+from gyrocal.recording import Recording
+from gyrocal.segmentation import segment
+from gyrocal.simulation import VirtualGyro
+from gyrocal.simulation.servo import PAPER_TURNS, ServoProtocol, simulate_servo
+from gyrocal.simulation.timestamps import ReceiveClock, with_time_defects
+
+K = np.array([1.0069, 0.9960, 0.9955])  # the servo method of Wang et al., Table III (MPU9250)
+B = np.array([0.0442, -0.0089, 0.0076])  # [rad/s]
+TRUE = np.concatenate([K, B])
+GYRO = VirtualGyro(ScaleBias(K, B), noise_std=0.01)
+BURSTY = ReceiveClock(packet=2, read_time=0.0035, jitter=0.003, late_per_minute=6, late_delay=0.08)
+
+
+def _z(run, truth=TRUE):
+    return (run.fit.model.params - truth) / run.fit.std
+
+
+def _rms(z):
+    return float(np.sqrt(np.mean(np.square(z))))
+
+
+def test_bursty_receive_stamps_give_the_right_scale(rng):
+    """Stamps in 3/17 ms bursts with late packets: the median step reads 200 Hz, the sensor runs at 100."""
+    z = []
+    for _ in range(8):
+        rec, _ = simulate_servo(GYRO, ServoProtocol(misalignment_deg=3), sample_rate=100, rng=rng)
+        bursty, _ = with_time_defects(rec, rng, clock=BURSTY)
+        assert np.median(np.diff(bursty.t)) < 0.006
+        run = calibrate(bursty, angle=2 * math.pi)
+        assert run.time_base.bursty and run.time_base.regular_clock
+        z.append(_z(run)[:3])
+    # 24 z-scores: RMS 1 +- 4 / sqrt(6 * 8) = 0.58 (the estimate is right within its 1-sigma)
+    assert _rms(z) < 1 + 4 / math.sqrt(6 * 8)
+
+
+def test_turns_across_packet_gaps_are_bounded_or_left_out(rng):
+    """Six 169 ms gaps in a 100 Hz log: a turn keeps a gap whose hidden angle is bounded small, and
+    leaves the session with the reason when it may hide more than 1 % of the turn."""
+    z, dropped, kept = [], 0, 0
+    for seed in range(10):
+        rec, _ = simulate_servo(GYRO, ServoProtocol(misalignment_deg=3), sample_rate=100, rng=rng)
+        gappy, truth = with_time_defects(rec, rng, clock=BURSTY if seed % 2 else None, gaps=6, gap_length=0.169)
+        try:
+            run = calibrate(gappy, angle=2 * math.pi)
+        except SegmentationError as err:  # both turns about an axis crossed a long gap: refused, with the reason
+            assert re.search(r"ignored \d+ \((\d+ short static, )?\d+ gap\)", str(err)), str(err)
+            continue
+        assert len(run.time_base.gaps) == 6 and run.time_base.lost == 6 * 17  # the simulator's truth
+        reasons = [r for _, r in run.segmentation.ignored if r.startswith("gap")]
+        assert all(re.match(r"gap: \d+ sample\(s\) missing inside the turn \(\d+(\.\d+)? ms step at sample \d+\); "
+                            r"the angle they hide may be \d", r) for r in reasons), reasons
+        dropped += len(reasons)
+        kept += sum(bool(run.time_base.gaps_in(w.start, w.stop)) for w in run.segmentation.rotations)
+        z.append(_z(run))
+    assert dropped and kept and len(z) >= 5  # both outcomes happen over these draws
+    assert _rms(z) < 1 + 4 / math.sqrt(12 * len(z))
+
+
+def test_a_wrong_declared_angle_is_measured_not_imposed(rng):
+    """Turns of 135/180/270 deg declared 150: each axis gets its own consistent turns; turns about one
+    axis that one scale factor cannot explain are left out with their measured angle."""
+    revs = (135 / 360, 180 / 360, 270 / 360, 135 / 360, 180 / 360, 270 / 360)
+    rec, _ = simulate_servo(GYRO, ServoProtocol(revolutions=revs, misalignment_deg=3), sample_rate=100, rng=rng)
+    run = calibrate(rec, angle=math.radians(150))
+    reasons = [r for w, r in run.segmentation.ignored if w.kind == "rotation"]
+    assert len(reasons) == 3 and all(r.startswith("wrong angle: turned ") for r in reasons)
+    # measured angles read the gyro's scale too (k = 1.0069: 135 deg reads 134)
+    assert any(re.search(r"turned 1[78]\d deg where the other x turns make 13\d deg \(declared 150 deg\)", r)
+               for r in reasons), reasons
+    # what is kept reads k = 150 / 135 etc., and is flagged as implausible for deg/s data
+    assert np.allclose(run.fit.model.k, K * [150 / 135, 150 / 135, 150 / 180], rtol=0.01)
+    assert sum("from 1 for data in rad/s" in w for w in run.warnings) == 3
+
+
+def test_windows_that_disagree_give_a_warning_and_a_scaled_covariance(rng):
+    """A windows file declares 150 deg for turns of 135-270 deg: every window is used, the fit's chi2
+    says they disagree, names them, and scales the covariance so the truth is within it."""
+    revs = (135 / 360, 180 / 360, 270 / 360, 135 / 360, 180 / 360, 270 / 360)
+    rec, truth = simulate_servo(GYRO, ServoProtocol(revolutions=revs, misalignment_deg=3), sample_rate=100,
+                                rng=rng)
+    windows = [dataclasses.replace(w, angle=math.radians(150)) if w.kind == "rotation" else w for w in truth.windows]
+    run = calibrate(rec, angle=math.radians(150), windows=windows)
+    q = run.quality
+    assert q.covariance_scaled and q.p_value < 1e-3 and q.birge_ratio > 10
+    assert run.warnings[0].startswith("the turns and static windows disagree beyond their noise")
+    assert all(run.calibration.windows[i]["kind"] == "rotation" for i in q.disagree)
+    assert q.birge_ratio == pytest.approx(math.sqrt(q.chi2 / q.dof))
+    raw = calibrate(rec, angle=math.radians(150), windows=windows, checks=False)
+    assert np.all(run.fit.std > 10 * raw.fit.std)  # the noise-only 1-sigma would claim 1e-4 on k
+
+
+def test_a_clean_session_passes_its_own_check():
+    """Over 60 clean sessions the p-values are uniform (Kolmogorov-Smirnov against U(0, 1), the
+    distribution a right chi2 test gives), and a fit is scaled only by chance: p < 0.001 expects 0.06
+    of 60; three or more would have Poisson probability 4e-5 (a 4-sigma tolerance)."""
+    from scipy.stats import kstest
+
+    p, scaled = [], 0
+    for seed in range(60):
+        rec, _ = simulate_servo(GYRO, ServoProtocol(misalignment_deg=3), rng=np.random.default_rng(seed))
+        q = calibrate(rec, angle=2 * math.pi).quality
+        p.append(q.p_value)
+        scaled += q.covariance_scaled
+    assert kstest(p, "uniform").pvalue > 1e-3 and scaled <= 2
+
+
+def test_no_degrees_of_freedom_is_said(rng):
+    rec, _ = simulate_servo(GYRO, ServoProtocol(), rng=rng)
+    run = calibrate(rec, speed=math.radians(60), method="algorithm1")
+    assert run.quality.dof == 0 and run.quality.p_value is None
+    assert run.warnings == ("no residual degrees of freedom: 6 equations for 6 parameters, so nothing checks the "
+                            "turns against each other; add static windows or repeat turns to let the fit check itself",)
+
+
+def test_a_wrong_declared_sample_rate_is_named(rng):
+    """A 20 Hz log declared 25 Hz (no time column): every turn reads 20 % short; the warning says so."""
+    rec, _ = simulate_servo(GYRO, ServoProtocol(speed=math.radians(25)), sample_rate=20, rng=rng)
+    run = calibrate(Recording.from_rate(rec.gyro, 25.0), angle=2 * math.pi)
+    np.testing.assert_allclose(run.fit.model.k, K * 25 / 20, rtol=0.01)
+    assert len(run.warnings) == 1
+    assert "every turn reads 20 % short" in run.warnings[0]
+    assert "is the sample rate 20 Hz rather than the 25 Hz declared?" in run.warnings[0], run.warnings[0]
+
+
+@pytest.mark.parametrize("k", [[1.55, 1.80, 1.30], [0.5, 0.6, 2.0]])
+@pytest.mark.parametrize("reference", ["speed", "angle"])
+def test_poor_gyros_are_found_and_flagged(k, reference, rng):
+    """k from 0.5 to 2 (the servo method's extreme study reaches 2): found by structure, within 4 sigma,
+    and each axis far from 1 warned about."""
+    gyro = VirtualGyro(ScaleBias(k, B), noise_std=0.01)
+    rec, _ = simulate_servo(gyro, ServoProtocol(misalignment_deg=3), rng=rng)
+    run = calibrate(rec, **({"speed": math.radians(60)} if reference == "speed" else {"angle": 2 * math.pi}))
+    assert len(run.segmentation.rotations) == 6
+    assert np.all(np.abs(_z(run, np.concatenate([k, B]))) < 4)
+    assert sum("from 1 for data in rad/s" in w for w in run.warnings) == 3
+
+
+def test_ripple_standard_errors_hold(rng):
+    """5 % speed ripple at 2.5 Hz with the speed reference: the RMS of error / reported sigma is within
+    0.8-1.5 (the sd of an RMS over 30 x 3 draws is 0.075) and the sigma at most 3x the white-noise one."""
+    z, z_plain, ratio = [], [], []
+    for _ in range(30):
+        p = ServoProtocol(speed=math.radians(120), ripple=0.05, ripple_freq=2.5, vibration=0, misalignment_deg=3)
+        rec, _ = simulate_servo(GYRO, p, rng=rng)
+        run = calibrate(rec, speed=math.radians(120))
+        plain = calibrate(rec, speed=math.radians(120), checks=False)  # plain means, white-noise sigma
+        z.append(_z(run)[:3])
+        z_plain.append(_z(plain)[:3])
+        ratio.append(run.fit.std[:3] / plain.fit.std[:3])
+    assert 0.8 <= _rms(z) <= 1.5
+    assert np.max(ratio) <= 3.0
+    # the defect is there: without the self-checks the plain means read the ripple, far beyond their sigma
+    assert _rms(z_plain) > 1.5 + 4 / math.sqrt(6 * 30)
+
+
+def test_the_paper_methods_refuse_whole_turns_with_ramps(rng):
+    rec, _ = simulate_servo(GYRO, ServoProtocol(), rng=rng)
+    for method, name in (("algorithm1", "Algorithm 1"), ("lm", "LM")):
+        with pytest.raises(InputError, match=rf"rotation window .* its rate varies \d+ %.*{name} \(the servo method of "
+                                             r"Wang et al\., eq\. 4-8\) assumes a constant speed.*use the default method"):
+            calibrate(rec, angle=2 * math.pi, method=method)
+    assert calibrate(rec, speed=math.radians(60), method="lm").fit.method == "lm"  # plateaus are constant
+
+
+@pytest.mark.parametrize("reference", ["speed", "angle"])
+def test_slow_turns_at_20_hz_are_one_window_each(reference):
+    """README's example row: 20 Hz, 25 deg/s. Every turn is one window, over 8 seeds."""
+    for seed in range(8):
+        rec, _ = simulate_servo(VirtualGyro(ScaleBias(K, B), noise_std=0.035), ServoProtocol(speed=math.radians(25)),
+                                sample_rate=20, rng=np.random.default_rng(seed))
+        seg = segment(rec, reference=reference, speed=math.radians(25))
+        assert [w.label for w in seg.rotations] == list(PAPER_TURNS)
+
+
+def test_constant_data_and_zero_noise_are_refused(rng):
+    zero = Recording.from_rate(np.zeros((2000, 3)), 100.0)
+    with pytest.raises(SegmentationError, match=r"every reading is the same \(0, 0, 0 on x, y, z\)"):
+        calibrate(zero, angle=2 * math.pi)
+    rec, _ = simulate_servo(GYRO, ServoProtocol(), rng=rng)
+    with pytest.raises(InputError, match="noise_std must be > 0 on every axis"):
+        calibrate(rec, angle=2 * math.pi, noise_std=0.0)
+
+
+def test_counts_print_their_implied_sensitivity_and_skip_the_re_poses(rng):
+    """Counts from an MPU-9250 at +-2000 deg/s (16.4 LSB per deg/s) with 90 deg re-poses between the turns:
+    the 360 deg turns are the calibration turns (never the most common motion), and the note names the setting."""
+    revs = (0.25, 0.25, 0.25, 1, 1, 1, 1, 1, 1, 0.25, 0.25)
+    turns = ("+x", "+y", "+z") + PAPER_TURNS + ("+y", "-y")
+    rec, _ = simulate_servo(GYRO, ServoProtocol(turns=turns, revolutions=revs, misalignment_deg=3), rng=rng)
+    counts = Recording(t=rec.t, gyro=np.round(rec.gyro * 16.4 * 180 / math.pi), units="counts", source_units="counts")
+    run = calibrate(counts, angle=2 * math.pi)
+    assert [w.label for w in run.segmentation.rotations] == list(PAPER_TURNS)
+    assert run.warnings == ()
+    assert len(run.notes) == 1 and "sensitivity of 16." in run.notes[0]
+    assert "+-2000 deg/s = 16.4 LSB/(deg/s) (InvenSense, Bosch)" in run.notes[0]
+
+
+def test_fit_quality_round_trips_through_its_document(rng):
+    rec, _ = simulate_servo(GYRO, ServoProtocol(), rng=rng)
+    q = calibrate(rec, angle=2 * math.pi).quality
+    doc = q.to_document()
+    assert set(doc) >= {"chi2", "dof", "p_value", "birge_ratio", "covariance_scaled", "residuals", "warnings"}
+    assert GoodnessOfFit.from_document(doc) == q
+    assert len(doc["residuals"]) == len(q.labels) and len(doc["residuals"][0]["z"]) == 3  # a static window first
