@@ -95,7 +95,7 @@ def simulate(
     seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
     reference: Annotated[Optional[Path], typer.Option(
         "--reference", help="Also write the log of a reference gyro on the same motion (its own clock, mount, rate "
-                            "and noise; the truth goes to the sidecar), for planning 'gyrocal verify'.")] = None,
+                            "and noise; the truth goes to the sidecar), for planning 'gyrocal verify' (default: none).")] = None,
     ref_sample_rate: Annotated[float, typer.Option("--ref-sample-rate", help="Reference rate [Hz].")] = 100.0,
     ref_offset: Annotated[float, typer.Option(
         "--ref-offset", help="Clock offset [s]: t_test = t_ref * (1 + drift) + offset.")] = 0.0,

@@ -196,7 +196,8 @@ def compare(
     files: Annotated[list[Path], typer.Argument(help="Two or more calibration files (or thermal files) of one unit.")],
     tolerance: Annotated[Optional[float], typer.Option(
         "--tolerance", help="Production check: exit 0 when every parameter of every file is within this many "
-                            "combined 1-sigma of the first file, 1 when not.", min=0.0)] = None,
+                            "combined 1-sigma of the first file, 1 when not (default: none; print the comparison, exit 0).",
+        min=0.0)] = None,
 ) -> None:
     """Compare calibrations of one unit (power cycles, days, rigs) in units of their combined 1-sigma."""
     from ..files import load
