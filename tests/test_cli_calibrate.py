@@ -205,7 +205,7 @@ def test_example_prints_parameters_with_uncertainty_and_truth(tmp_path):
     out, png = tmp_path / "cal.json", tmp_path / "cal.png"
     code, stdout, err = invoke("calibrate", "--example", "-o", out, "--plot", png)
     assert code == 0, err
-    assert "truth" in stdout and "error / sigma" in stdout and "1-sigma" in stdout
+    assert "truth" in stdout and "/ sigma" in stdout and "1-sigma" in stdout and "at rest" in stdout
     cal = load_calibration(out)
     _within_4_sigma(cal)
     assert len([w for w in cal.windows if w["kind"] == "rotation"]) == 6
@@ -246,8 +246,11 @@ def test_apply_corrects_and_passes_other_columns_through(servo_csv, tmp_path):
     assert np.allclose(corrected.gyro, cal.model.correct(raw.gyro), atol=1e-12)
     assert np.array_equal(corrected.t, raw.t)
     assert list(corrected.extra["note"][:3]) == ["n0", "n1", "n2"]
+    # another rate unit is converted, so the reader's own unit check speaks; counts never mix with rates
     line = refused("apply", cal_path, src, "--units", "rad/s", "-o", tmp_path / "x.csv")
-    assert "does not match" in line and "deg/s" in line
+    assert "the data are almost surely in deg/s" in line
+    line = refused("apply", cal_path, src, "--units", "counts", "-o", tmp_path / "x.csv")
+    assert "--units counts does not match the calibration's input units deg/s" in line
     assert not (tmp_path / "x.csv").exists()
 
 

@@ -81,7 +81,7 @@ def test_counts_without_sensitivity_calibrate_to_output_units(rng):
     assert (cal.input_units, cal.output_units, cal.internal_units) == ("counts", "deg/s", "counts")
     # In user units the scale is deg/s per count: K / lsb, and the offset is -b in counts.
     (_, value, sigma, unit), *_ = run.parameters()
-    assert unit == "deg/s per counts"
+    assert unit == "deg/s per count"
     assert abs(value - K[0] / lsb) < 4 * sigma
     matrix, offset = cal.correction
     np.testing.assert_allclose(np.diag(matrix), [p[1] for p in run.parameters()[:3]])

@@ -73,9 +73,10 @@ def _headerless(path: Path, lines: list[str], layout: Layout) -> InputError:
     numbers = "t=1,gx=2,gy=3,gz=4" if timed else "gx=1,gy=2,gz=3"
     sep = layout.delimiter or " "
     return InputError(
-        f"{path.name}: the first line ({first[:40].strip()!r}) is data, not a header; say which column holds what "
-        f"by number, counting from 1 (--columns {numbers}{'' if timed else ' with --sample-rate HZ'}), or add a "
-        f"header row naming the columns, e.g. {sep.join(('t', 'gx', 'gy', 'gz'))!r}"
+        f"{path.name}: the first line ({first[:40].strip()!r}) is data, not a header", param="columns",
+        hint=f"say which column holds what by number, counting from 1 ({{param}} {numbers}"
+             f"{'' if timed else ' with {param:sample_rate} HZ'}), or add a header row naming the columns, "
+             f"e.g. {sep.join(('t', 'gx', 'gy', 'gz'))!r}"
     )
 
 
@@ -86,7 +87,7 @@ def _mapped(path: Path, lines: list[str], layout: Layout, columns, accel: bool =
     if not columns and layout.header is not None and names == [str(i) for i in range(len(names))]:
         raise InputError(
             f"{path.name}: the header ({lines[layout.header][:40].strip()!r}) numbers the columns from 0, as pandas "
-            f"writes them; say which column holds what by those names, e.g. --columns t=0,gx=1,gy=2,gz=3"
+            "writes them", param="columns", hint="say which column holds what by those names, e.g. {param} t=0,gx=1,gy=2,gz=3"
         )
     error = None
     for reading in (layout, *layout.others):
