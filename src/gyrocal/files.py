@@ -29,6 +29,7 @@ KIND_MODULES: dict[str, str] = {
     "gyrocal.calibration": "gyrocal.calibration",
     "gyrocal.thermal": "gyrocal.thermal.model",
     "gyrocal.simulation-truth": "gyrocal.simulation.truth",
+    "gyrocal.verify": "gyrocal.verify.report",
 }
 
 _KINDS: dict[str, type] = {}

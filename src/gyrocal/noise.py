@@ -23,9 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ._arrays import readonly
 from ._jsonfile import check_header, get, get_array, read_json, write_json
 from ._validation import finite_array, positive
-from ._arrays import readonly
 from .errors import FileFormatError, InputError, MissingDependencyError
 
 __all__ = ["NoiseReport", "allan_deviation", "characterise", "save_noise", "load_noise", "noise_density_arg"]

@@ -53,7 +53,8 @@ def triple(name: str, text: str | None, default) -> list[float]:
 
 NoiseDensity = Annotated[Optional[str], typer.Option(
     "--noise-density",
-    help="White-noise density: rad/s/sqrt(Hz), 'N deg/s/rtHz', or a noise JSON from 'gyrocal noise --json'.")]
+    help="White-noise density: rad/s/sqrt(Hz), 'N deg/s/rtHz', or a noise JSON from 'gyrocal noise --json' "
+         "(default: none; --noise, or the study's own levels, apply).")]
 
 
 def noise_std(noise: float | None, density: str | None, sample_rate: float, default: float):

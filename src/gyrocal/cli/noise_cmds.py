@@ -22,8 +22,10 @@ def noise(
     units: READING.Units = None,
     columns: READING.Columns = None,
     sample_rate: READING.SampleRate = None,
-    plot: Annotated[Optional[Path], typer.Option("--plot", help="Allan deviation plot (.png, .pdf, .svg).")] = None,
-    json_out: Annotated[Optional[Path], typer.Option("--json", help="Write the noise figures as JSON.")] = None,
+    plot: Annotated[Optional[Path], typer.Option(
+        "--plot", help="Allan deviation plot (.png, .pdf, .svg) (default: none).")] = None,
+    json_out: Annotated[Optional[Path], typer.Option(
+        "--json", help="Write the noise figures as JSON (default: none).")] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace a --json file that is not a noise file.")]
     = False,
 ) -> None:

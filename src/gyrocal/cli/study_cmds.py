@@ -34,7 +34,8 @@ def study(
     reps: Annotated[Optional[int], typer.Option("--reps", help="Calibrations per gyro (default: the paper's).")] = None,
     seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
     methods: Annotated[Optional[str], typer.Option(
-        "--methods", help="servo-speed: estimators, comma-separated (algorithm1, lm, first-moment).")] = None,
+        "--methods", help="servo-speed: estimators, comma-separated (algorithm1, lm, first-moment) (default: "
+        "all three).")] = None,
     noise_density: NoiseDensity = None,
     sample_rate: Annotated[float, typer.Option(
         "--sample-rate", help="Sampling rate [Hz] (thermal-compare's default: 100).")] = 200.0,

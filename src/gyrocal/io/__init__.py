@@ -5,11 +5,11 @@ MCAP bags (``ros`` extra). Everything comes back as a checked
 :class:`~gyrocal.recording.Recording` in internal units.
 """
 
-from .profile import read_profile
-from .reader import read_recording
-from .session import read_session
 from ..saturation import find_saturation
+from .profile import read_profile
+from .reader import read_header_comment, read_recording
+from .session import read_session
 from .windowsfile import read_windows
 from .writer import recording_columns, write_csv, write_recording
 
-__all__ = ["find_saturation", "read_profile", "read_recording", "read_session", "read_windows", "recording_columns", "write_csv", "write_recording"]
+__all__ = ["find_saturation", "read_header_comment", "read_profile", "read_recording", "read_session", "read_windows", "recording_columns", "write_csv", "write_recording"]

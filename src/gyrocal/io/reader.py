@@ -10,7 +10,7 @@ from ..recording import Recording
 from ._build import STANDARD_GRAVITY, SaturationPolicy, build_recording
 from ._source import compression
 
-__all__ = ["read_recording", "TEXT_SUFFIXES", "BAG_SUFFIXES"]
+__all__ = ["read_recording", "read_header_comment", "TEXT_SUFFIXES", "BAG_SUFFIXES"]
 
 TEXT_SUFFIXES = (".csv", ".txt", ".tsv", ".dat")
 BAG_SUFFIXES = (".bag", ".db3", ".mcap")
@@ -127,14 +127,16 @@ def read_recording(
     kind = _kind(path)
     if skip_rows is not None:
         if kind != "text":
-            raise InputError(f"skip_rows applies to text tables only; {path.name} is a {kind} file")
+            raise InputError(f"{{param}} applies to text tables only; {path.name} is a {kind} file", param="skip_rows")
         if isinstance(skip_rows, bool) or not isinstance(skip_rows, int) or skip_rows < 0:
-            raise InputError(f"skip_rows must be a whole number >= 0, got {skip_rows!r}")
+            raise InputError(f"{{param}} must be a whole number >= 0, got {skip_rows!r}", param="skip_rows",
+                             value=skip_rows)
     if kind == "bag":
         from .rosbag import read_bag_columns
 
         if columns:
-            raise InputError("columns= does not apply to ROS bags (angular_velocity and header stamps are used)")
+            raise InputError("{param} does not apply to ROS bags (angular_velocity and header stamps are used)",
+                             param="columns")
         data, extra = read_bag_columns(path, topic, accel=accel)
     elif kind == "parquet":
         from .parquet import read_parquet_columns
@@ -159,3 +161,23 @@ def read_recording(
         accel_sensitivity=accel_sensitivity,
         gravity=gravity,
     )
+
+
+def read_header_comment(path: str | os.PathLike) -> str | None:
+    """The first line of a text table when it is a ``#`` comment (without the ``#``), else None.
+
+    ``gyrocal apply`` and ``gyrocal simulate`` say there what wrote the file; Parquet files and
+    bags have no such line.
+    """
+    from ._source import open_bytes
+
+    path = Path(path)
+    if not path.is_file() or _kind(path) != "text":
+        return None
+    try:
+        with open_bytes(path, compression(path)) as f:
+            head = f.read(4096)
+    except (OSError, EOFError, InputError):
+        return None
+    line = head.decode("utf-8-sig", errors="replace").lstrip("\n\r").split("\n", 1)[0].strip()
+    return line[1:].strip() if line.startswith("#") else None
