@@ -21,9 +21,9 @@ from scipy import stats
 
 from ..errors import DegenerateDesignError, InputError
 from . import _fit
+from ._gyro_cov import noise_model
 from ._gyro_problem import EARTH_RATE, GyroProblem, Turn, build_problem
 from ._gyro_solve import MASKS, initial_scale, screen_pairs, solve, unpack
-from ._gyro_cov import noise_model
 from .accel import AccelFit
 
 __all__ = ["EARTH_RATE", "GYRO_MODELS", "GyroFit", "GyroModel", "PairCheck", "Turn", "fit_gyroscope"]

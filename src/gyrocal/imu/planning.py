@@ -20,8 +20,8 @@ from .._validation import positive
 from ..errors import DegenerateDesignError, InputError
 from . import _fit
 from . import quaternion as quat
-from ._gyro_problem import build_problem
 from ._gyro_cov import noise_model, whitener
+from ._gyro_problem import build_problem
 from ._gyro_solve import jacobian, residuals
 from .accel import fit_accelerometer
 from .accel import param_names as accel_names
