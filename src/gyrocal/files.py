@@ -31,6 +31,7 @@ KIND_MODULES: dict[str, str] = {
     "gyrocal.simulation-truth": "gyrocal.simulation.truth",
     "gyrocal.noise": "gyrocal.noise_file",
     "gyrocal.thermal-bias": "gyrocal.thermal_bias_file",
+    "gyrocal.verify": "gyrocal.verify.report",
 }
 
 _KINDS: dict[str, type] = {}

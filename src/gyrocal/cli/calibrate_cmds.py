@@ -314,6 +314,7 @@ def segments(
     plot: PlotPath = None,
 ) -> None:
     """Show the rotation and static windows detected (or read from --windows) and what was ignored and why."""
+    # long function: the command's output in the order it is printed (time base, windows, what was ignored)
     from rich.markup import escape
     from rich.table import Table
 
