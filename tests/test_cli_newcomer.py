@@ -251,3 +251,27 @@ def test_no_rotation_says_what_was_measured_and_the_likely_fix(session, tmp_path
     assert code == 0, err
     line = refused("calibrate", tmp_path / "two.csv", "--units", "deg/s")
     assert "no rotation about z" in line and "turn about the missing axes too" in line
+
+
+# ---------------------------------------------------------------- plan
+
+
+def test_plan_says_when_the_protocol_as_given_meets_the_target_and_never_worsens_it():
+    """Reference: the Cramer-Rao prediction of the protocol as given (the first row), computed by predict()."""
+    import math
+
+    from gyrocal.planning import predict
+
+    given = predict("six", speed=math.radians(60), noise_density=0.035 / math.sqrt(200.0))
+    code, out, _ = invoke("plan", "--target-bias", "0.05deg/s")
+    flat = " ".join(out.split())
+    assert code == 0 and "the protocol as given already meets the target std b <= 0.05 deg/s" in flat
+    assert "suggested" not in out  # every shorter protocol on the grid has a larger bias std
+    assert given.max_bias_std < math.radians(0.05)
+    code, out, _ = invoke("plan", "--target-scale", "1e-3")
+    rows = {cells[1]: cells for line in out.splitlines()
+            if len(cells := [c.strip() for c in line.split("\u2502")]) > 6 and cells[1] in ("as given", "suggested")}
+    k_given, k_suggested = (float(rows[key][5]) for key in ("as given", "suggested"))
+    assert k_suggested <= k_given and "already meets the target std k <= 0.001" in " ".join(out.split())
+    code, out, _ = invoke("plan", "--target-bias", "0.01deg/s")
+    assert code == 0 and "misses the target" in " ".join(out.split()) and "suggested" in out
