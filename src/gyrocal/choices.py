@@ -10,11 +10,14 @@ from __future__ import annotations
 from typing import Literal, get_args
 
 __all__ = [
+    "AccelModel",
+    "AccelOutputUnit",
     "AccelUnit",
     "CaptureWire",
     "DesignName",
     "DeviceWire",
     "GuideName",
+    "ImuGyroModel",
     "InputUnit",
     "Method",
     "OutOfRange",
@@ -52,6 +55,13 @@ DeviceWire = Literal["frames", "text"]
 GuideName = Literal["servo", "hand"]
 #: Experimental designs of the planner (see :mod:`gyrocal.planning`).
 DesignName = Literal["six", "six-static", "twelve"]
+#: Accelerometer models of the whole-IMU calibration ("auto": the largest the poses determine;
+#: see :mod:`gyrocal.imu.accel`).
+AccelModel = Literal["auto", "affine", "triangular", "scale-bias"]
+#: Gyro models of the whole-IMU calibration (see :mod:`gyrocal.imu.gyro`).
+ImuGyroModel = Literal["auto", "affine", "scale"]
+#: Units of corrected accelerations.
+AccelOutputUnit = Literal["m/s^2", "g"]
 
 
 def values(choice) -> tuple[str, ...]:

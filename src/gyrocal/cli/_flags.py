@@ -32,6 +32,12 @@ FLAGS: dict[str, str] = {
     "method": "--method",
     "noise_std": "--noise-std",
     "noise_density": "--noise-density",
+    # imu
+    "accel_model": "--accel-model",
+    "gyro_model": "--gyro-model",
+    "g_sensitivity": "--g-sensitivity",
+    "min_static": "--min-static",
+    "accel_output_units": "--accel-output-units",
     # apply, export
     "model": "--model",
     "out_of_range": "--out-of-range",
