@@ -44,7 +44,7 @@ OutOfRange = Literal["refuse", "clamp", "extrapolate"]
 #: How a thermal table is evaluated in temperature ("traditional": the paper's one-temperature baseline).
 TableModel = Literal["lagrange", "smooth", "traditional"]
 #: Motion sources of ``gyrocal simulate`` (see :mod:`gyrocal.simulation`).
-Protocol = Literal["servo", "hand", "turntable", "profile"]
+Protocol = Literal["servo", "hand", "turntable", "profile", "multi-position"]
 #: Monte Carlo studies reproducing the papers (see :mod:`gyrocal.studies`).
 StudyName = Literal["servo-normal", "servo-extreme", "servo-speed", "servo-convergence", "thermal-compare"]
 #: Wire formats ``gyrocal capture`` reads ("auto": whichever decodes first; see :mod:`gyrocal.capture`).

@@ -64,6 +64,11 @@ FLAGS: dict[str, str] = {
     "quantum": "--quantum",
     "bias_instability": "--bias-instability",
     "rate_random_walk": "--rrw",
+    # simulate --protocol multi-position, plan --poses
+    "poses": "--poses",
+    "turn_deg": "--tilt",
+    "static_duration": "--still",
+    "accel_noise_std": "--accel-noise",
     # capture, simulate --device
     "port": "--port",
     "baud": "--baud",

@@ -24,9 +24,11 @@ _SIMULATED = "gyrocal simulate"  # first words of a simulated recording: a later
 _SERVO = ("servo", "hand")
 #: Flags that only some protocols use; the rest apply to every protocol.
 _PROTOCOL_FLAGS = {
-    **dict.fromkeys(("speed", "turns", "wait", "ramp", "misalignment"), _SERVO), "vibration": ("servo",),
+    **dict.fromkeys(("speed", "turns", "wait", "ramp"), _SERVO), "vibration": ("servo",),
+    "misalignment": (*_SERVO, "multi-position"),
     # the turntable gyro follows the full-temperature-range method's thermal truth
-    **dict.fromkeys(("k", "b"), (*_SERVO, "profile")),
+    **dict.fromkeys(("k", "b"), (*_SERVO, "profile", "multi-position")),
+    **dict.fromkeys(("poses", "tilt", "still", "accel_noise"), ("multi-position",)),
     **dict.fromkeys(("temps", "rates", "step_duration", "temp_noise", "temp_quantum"), ("turntable",)),
     **dict.fromkeys(("profile", "profile_units", "duration"), ("profile",)),
     # a reference log needs turns about several axes, which the single-axis turntable does not make
@@ -73,6 +75,14 @@ def simulate(
     rate_random_walk: Annotated[float, typer.Option("--rrw", help="Rate random walk [rad/s/sqrt(s)].")] = 0.0,
     quantum: Annotated[Optional[float], typer.Option("--quantum", help="Output resolution [rad/s] (default: none, not quantised).")] = None,
     full_scale: Annotated[Optional[float], typer.Option("--full-scale", help="Saturation [deg/s] (default: none, never saturates).")] = None,
+    poses: Annotated[int, typer.Option(
+        "--poses", help="--protocol multi-position: still poses of the hand session.")] = 24,
+    tilt: Annotated[float, typer.Option(
+        "--tilt", help="--protocol multi-position: tilt between successive poses [deg].")] = 90.0,
+    still: Annotated[float, typer.Option(
+        "--still", help="--protocol multi-position: still time in each pose [s] (each drawn within +-25 %).")] = 3.0,
+    accel_noise: Annotated[float, typer.Option(
+        "--accel-noise", help="--protocol multi-position: accelerometer noise per sample [m/s^2].")] = 0.02,
     profile: Annotated[Optional[Path], typer.Option("--profile", help="--protocol profile: CSV of t,wx,wy,wz (required there).")] = None,
     profile_units: Annotated[str, typer.Option("--profile-units", help="Unit of the profile rates.")] = "rad/s",
     duration: Annotated[Optional[float], typer.Option("--duration", help="--protocol profile: length [s] (required there).")] = None,
@@ -152,6 +162,9 @@ def simulate(
     if protocol in _SERVO:
         rec, facts, true_rates = _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misalignment,
                                         sample_rate, rng, settings)
+    elif protocol == "multi-position":
+        rec, model, facts = _multi_position(model, gyro_kw, poses, tilt, still, accel_noise, misalignment,
+                                            sample_rate, rng, settings)
     elif protocol == "turntable":
         rec, model, facts = _turntable(gyro_kw, _turntable_protocol(temps, rates, step_duration, temp_noise,
                                                                      temp_quantum), sample_rate, rng, settings)
@@ -268,6 +281,22 @@ def _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misali
     settings.update(speed_deg_s=speed, turns=list(turn_list), wait_s=wait, ramp_s=ramp, vibration=vibration,
                     misalignment_deg=misalignment)
     return rec, servo_facts(truth), truth.rates
+
+
+def _multi_position(model, gyro_kw, poses, tilt, still, accel_noise, misalignment, sample_rate, rng, settings):
+    """A hand multi-position session of a whole IMU: the recording (with ax, ay, az), gyro model, facts."""
+    from ..simulation import VirtualGyro
+    from ..simulation.multiposition import (MultiPositionProtocol, VirtualImu, mounted_gyro, random_accelerometer,
+                                            session_facts, session_recording, simulate_multi_position)
+
+    gyro = mounted_gyro(model, misalignment, rng)
+    a, o = random_accelerometer(rng)
+    imu = VirtualImu(VirtualGyro(gyro, **gyro_kw), accel_matrix=a, accel_offset=o, accel_noise_std=accel_noise)
+    proto = MultiPositionProtocol(poses=poses, turn_deg=tilt, static_duration=(0.75 * still, 1.25 * still),
+                                  sample_rate=sample_rate)
+    session = simulate_multi_position(imu, proto, rng=rng)
+    settings.update(poses=poses, tilt_deg=tilt, still_s=still, accel_noise=accel_noise, misalignment_deg=misalignment)
+    return session_recording(session), gyro, session_facts(session)
 
 
 def _turntable(gyro_kw, proto, sample_rate, rng, settings):

@@ -26,7 +26,8 @@ from ..imu import quaternion as quat
 from ..imu.gyro import EARTH_RATE
 from .gyro import VirtualGyro
 
-__all__ = ["ImuSession", "MultiPositionProtocol", "VirtualImu", "simulate_multi_position"]
+__all__ = ["ImuSession", "MultiPositionProtocol", "VirtualImu", "mounted_gyro", "random_accelerometer",
+           "session_facts", "session_recording", "simulate_multi_position"]
 
 
 @dataclass(frozen=True)
@@ -260,3 +261,45 @@ def simulate_multi_position(imu: VirtualImu, protocol: MultiPositionProtocol | N
              "gyro_matrix": np.linalg.inv(aff.K), "gyro_offset": np.array(aff.B),
              "g_sensitivity": imu.g_sensitivity.copy(), "gravity": p.gravity}
     return ImuSession(t=t, gyro=gyro, accel=accel, still=still, orientations=q_poses, truth=truth)
+
+
+def random_accelerometer(rng: np.random.Generator, *, scale_error: float = 0.02, cross_deg: float = 0.5,
+                         offset: float = 0.1) -> tuple[np.ndarray, np.ndarray]:
+    """A plausible MEMS accelerometer truth in the 9-parameter model's frame: ``(A, o)``.
+
+    Scale factors within ``1 +- scale_error``, non-orthogonality of about `cross_deg` [deg],
+    offsets of about `offset` [m/s^2] (lower-triangular ``A``: x along the sensor's x axis).
+    """
+    a = np.eye(3) * (1 + rng.uniform(-scale_error, scale_error, 3))
+    a[np.tril_indices(3, -1)] = rng.normal(0.0, np.radians(cross_deg), 3)
+    return a, rng.normal(0.0, offset, 3)
+
+
+def mounted_gyro(model, misalignment_deg: float, rng: np.random.Generator):
+    """`model` (scale and bias) with its axes turned by `misalignment_deg` [deg] about a random axis
+    from the accelerometer's frame, as an :class:`~gyrocal.models.Affine` (readings ``K w + B``)."""
+    from ..models import Affine
+
+    aff = model.to_affine()
+    axis = rng.normal(size=3)
+    turn = quat.to_matrix(quat.from_rotvec(np.radians(misalignment_deg) * axis / np.linalg.norm(axis)))
+    return Affine(K=aff.K @ turn.T, B=aff.B)
+
+
+def session_recording(session: ImuSession, units: str = "rad/s"):
+    """The simulated session as a :class:`~gyrocal.recording.Recording` (gyro rad/s, accelerometer m/s^2)."""
+    from ..recording import Recording
+
+    return Recording(t=session.t, gyro=session.gyro, accel=session.accel, accel_units="m/s^2",
+                     accel_source_units="m/s^2", source_units=units)
+
+
+def session_facts(session: ImuSession) -> dict:
+    """The truth of a session beyond the gyro model, as JSON for the truth file."""
+    tr = session.truth
+    return {"accelerometer": {"matrix": tr["accel_matrix"].tolist(), "offset": tr["accel_offset"].tolist(),
+                              "units": "m/s^2", "equation": "a_true = matrix @ (raw - offset)"},
+            "gyro_correction": {"matrix": tr["gyro_matrix"].tolist(), "offset": tr["gyro_offset"].tolist(),
+                                "units": "rad/s", "equation": "w_true = matrix @ (raw - offset - G a_true)"},
+            "g_sensitivity": tr["g_sensitivity"].tolist(), "gravity": tr["gravity"],
+            "poses": session.orientations.tolist(), "still": session.still.tolist()}
