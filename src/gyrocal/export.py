@@ -24,6 +24,7 @@ EXPORTER_MODULES: dict[str, str] = {
     "json": "gyrocal.exporters",
     "yaml": "gyrocal.exporters",
     "c-header": "gyrocal.exporters",
+    "imucal": "gyrocal.imucal_export",
 }
 #: The export formats, in the order the command line lists them.
 EXPORT_FORMATS: tuple[str, ...] = tuple(EXPORTER_MODULES)
