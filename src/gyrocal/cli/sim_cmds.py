@@ -286,8 +286,15 @@ def _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misali
 def _multi_position(model, gyro_kw, poses, tilt, still, accel_noise, misalignment, sample_rate, rng, settings):
     """A hand multi-position session of a whole IMU: the recording (with ax, ay, az), gyro model, facts."""
     from ..simulation import VirtualGyro
-    from ..simulation.multiposition import (MultiPositionProtocol, VirtualImu, mounted_gyro, random_accelerometer,
-                                            session_facts, session_recording, simulate_multi_position)
+    from ..simulation.multiposition import (
+        MultiPositionProtocol,
+        VirtualImu,
+        mounted_gyro,
+        random_accelerometer,
+        session_facts,
+        session_recording,
+        simulate_multi_position,
+    )
 
     gyro = mounted_gyro(model, misalignment, rng)
     a, o = random_accelerometer(rng)
