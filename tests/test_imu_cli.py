@@ -15,6 +15,7 @@ from gyrocal import firmware
 from gyrocal.files import load
 from gyrocal.io import read_recording
 
+
 @pytest.fixture(scope="module")
 def session(tmp_path_factory):
     """A simulated 20-pose session (deg/s, m/s^2) and its calibration file."""

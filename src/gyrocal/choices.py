@@ -21,6 +21,7 @@ __all__ = [
     "InputUnit",
     "Method",
     "OutOfRange",
+    "PlanDesign",
     "Protocol",
     "RateUnit",
     "SaturationPolicy",
@@ -55,6 +56,9 @@ DeviceWire = Literal["frames", "text"]
 GuideName = Literal["servo", "hand"]
 #: Experimental designs of the planner (see :mod:`gyrocal.planning`).
 DesignName = Literal["six", "six-static", "twelve"]
+#: Designs ``gyrocal plan`` predicts: the servo designs, and a hand session of still poses (see
+#: :mod:`gyrocal.imu.planning`).
+PlanDesign = Literal["six", "six-static", "twelve", "poses"]
 #: Accelerometer models of the whole-IMU calibration ("auto": the largest the poses determine;
 #: see :mod:`gyrocal.imu.accel`).
 AccelModel = Literal["auto", "affine", "triangular", "scale-bias"]

@@ -64,7 +64,7 @@ FLAGS: dict[str, str] = {
     "quantum": "--quantum",
     "bias_instability": "--bias-instability",
     "rate_random_walk": "--rrw",
-    # simulate --protocol multi-position, plan --poses
+    # simulate --protocol multi-position, plan --design poses
     "poses": "--poses",
     "turn_deg": "--tilt",
     "static_duration": "--still",
