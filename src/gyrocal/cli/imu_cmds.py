@@ -56,16 +56,17 @@ def _print_accel(run) -> None:
 
 def _matrix_table(matrix, matrix_std, offset, offset_std, input_units: str):
     """Rows x, y, z: the correction matrix and offset, each entry with its 1-sigma."""
+    from rich import box
     from rich.markup import escape
     from rich.table import Table
 
-    table = Table()
+    table = Table(box=box.SIMPLE_HEAD, pad_edge=False)
     for col in ("axis", "matrix x", "matrix y", "matrix z", escape(f"offset [{input_units}]")):
         table.add_column(col, justify="right")
     for r, axis in enumerate("xyz"):
-        cells = [f"{matrix[r][c]:.5g} ±{matrix_std[r][c]:.1g}" if matrix_std[r][c] > 0 else f"{matrix[r][c]:.5g}"
-                 for c in range(3)]
-        table.add_row(axis, *cells, f"{offset[r]:.5g} ±{offset_std[r]:.2g}")
+        table.add_row(axis, *(f"{matrix[r][c]:.6g}" for c in range(3)), f"{offset[r]:.6g}")
+        table.add_row("±1σ", *(f"{matrix_std[r][c]:.2g}" if matrix_std[r][c] > 0 else "" for c in range(3)),
+                      f"{offset_std[r]:.2g}", style="dim")
     return table
 
 
