@@ -20,6 +20,7 @@ __all__ = [
     "ImuGyroModel",
     "InputUnit",
     "Method",
+    "MotionPolicy",
     "OutOfRange",
     "PlanDesign",
     "Protocol",
@@ -45,7 +46,9 @@ OutOfRange = Literal["refuse", "clamp", "extrapolate"]
 #: How a thermal table is evaluated in temperature ("traditional": the paper's one-temperature baseline).
 TableModel = Literal["lagrange", "smooth", "traditional"]
 #: Motion sources of ``gyrocal simulate`` (see :mod:`gyrocal.simulation`).
-Protocol = Literal["servo", "hand", "turntable", "profile", "multi-position"]
+Protocol = Literal["servo", "hand", "turntable", "profile", "static", "multi-position"]
+#: What a noise analysis does with a log that moves: analyse its longest still stretch, or refuse it.
+MotionPolicy = Literal["restrict", "refuse"]
 #: Monte Carlo studies reproducing the papers (see :mod:`gyrocal.studies`).
 StudyName = Literal["servo-normal", "servo-extreme", "servo-speed", "servo-convergence", "thermal-compare"]
 #: Wire formats ``gyrocal capture`` reads ("auto": whichever decodes first; see :mod:`gyrocal.capture`).

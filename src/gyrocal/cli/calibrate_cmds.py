@@ -82,7 +82,7 @@ def _noise_to_internal(noise_std: float | None, units: str, rate_unit: str, sens
 
 def _density_to_internal(noise_density: str, noise_std: float | None, rec):
     """--noise-density (rad/s/sqrt(Hz), per axis) as per-sample noise [rad/s] at the recording's rate."""
-    from ..noise import noise_density_arg
+    from ..noise_file import noise_density_arg
 
     if noise_std is not None:
         raise InputError("give --noise-std or --noise-density, not both")

@@ -28,9 +28,13 @@ _PROTOCOL_FLAGS = {
     "misalignment": (*_SERVO, "multi-position"),
     # the turntable gyro follows the full-temperature-range method's thermal truth
     **dict.fromkeys(("k", "b"), (*_SERVO, "profile", "multi-position")),
-    **dict.fromkeys(("poses", "tilt", "still", "accel_noise"), ("multi-position",)),
-    **dict.fromkeys(("temps", "rates", "step_duration", "temp_noise", "temp_quantum"), ("turntable",)),
-    **dict.fromkeys(("profile", "profile_units", "duration"), ("profile",)),
+    **dict.fromkeys(("poses", "tilt", "still"), ("multi-position",)),
+    **dict.fromkeys(("temps", "rates", "step_duration"), ("turntable",)),
+    **dict.fromkeys(("temp_noise", "temp_quantum"), ("turntable", "static")),
+    **dict.fromkeys(("profile", "profile_units"), ("profile",)),
+    "duration": ("profile", "static"),
+    **dict.fromkeys(("temp_start", "temp_end", "warmup_tau", "bias_tempco", "accel_random_walk"), ("static",)),
+    "accel_noise_density": ("static", "multi-position"),
     # a reference log needs turns about several axes, which the single-axis turntable does not make
     "reference": (*_SERVO, "profile"),
 }
@@ -81,11 +85,28 @@ def simulate(
         "--tilt", help="--protocol multi-position: tilt between successive poses [deg].")] = 90.0,
     still: Annotated[float, typer.Option(
         "--still", help="--protocol multi-position: still time in each pose [s] (each drawn within +-25 %).")] = 3.0,
-    accel_noise: Annotated[float, typer.Option(
-        "--accel-noise", help="--protocol multi-position: accelerometer noise per sample [m/s^2].")] = 0.02,
     profile: Annotated[Optional[Path], typer.Option("--profile", help="--protocol profile: CSV of t,wx,wy,wz (required there).")] = None,
     profile_units: Annotated[str, typer.Option("--profile-units", help="Unit of the profile rates.")] = "rad/s",
-    duration: Annotated[Optional[float], typer.Option("--duration", help="--protocol profile: length [s] (required there).")] = None,
+    duration: Annotated[Optional[float], typer.Option(
+        "--duration", help="--protocol profile, static: length [s] (required there).")] = None,
+    temp_start: Annotated[float, typer.Option(
+        "--temp-start", help="--protocol static: temperature at power-on [degC].")] = 25.0,
+    temp_end: Annotated[float, typer.Option(
+        "--temp-end", help="--protocol static: temperature the board warms to [degC] (= --temp-start: no warm-up).")]
+    = 25.0,
+    warmup_tau: Annotated[float, typer.Option(
+        "--warmup-tau", help="--protocol static: time constant of the exponential warm-up [s].")] = 600.0,
+    bias_tempco: Annotated[Optional[str], typer.Option(
+        "--bias-tempco", help="--protocol static: bias against temperature, x,y,z [rad/s/degC^n] for n = 1, 2, .. "
+                              "about 25 degC, ';' between powers, e.g. 1e-4,-5e-5,2e-5;1e-6,0,0 (default: none, "
+                              "no temperature dependence).")] = None,
+    accel_noise_density: Annotated[Optional[float], typer.Option(
+        "--accel-noise-density", help="--protocol static: also an accelerometer (gravity on z), white noise "
+                                      "[m/s^2/sqrt(Hz)] (default: none, no accelerometer); --protocol "
+                                      "multi-position: the accelerometer's noise (default: 0.002).")] = None,
+    accel_random_walk: Annotated[Optional[float], typer.Option(
+        "--accel-random-walk", help="--protocol static: accelerometer bias random walk [m/s^3/sqrt(Hz)] (default: "
+                                    "none, no accelerometer; 0 with --accel-noise-density).")] = None,
     temps: Annotated[Optional[str], typer.Option(
         "--temps", help="--protocol turntable: temperatures [degC], comma-separated (default: the full-temperature-"
                         "range method's Table 1, -40 to 50 by 10).")] = None,
@@ -96,9 +117,9 @@ def simulate(
         "--step-duration", help="--protocol turntable: length of each rate step [s] (default: 60, the paper's).")]
     = None,
     temp_noise: Annotated[float, typer.Option(
-        "--temp-noise", help="--protocol turntable: std of each temperature reading [degC].")] = 0.0,
+        "--temp-noise", help="--protocol turntable, static: std of each temperature reading [degC].")] = 0.0,
     temp_quantum: Annotated[Optional[float], typer.Option(
-        "--temp-quantum", help="--protocol turntable: resolution of the temperature readings [degC], e.g. 1 (default: none, not quantised).")]
+        "--temp-quantum", help="--protocol turntable, static: resolution of the temperature readings [degC], e.g. 1 (default: none, not quantised).")]
     = None,
     sample_rate: Annotated[float, typer.Option("--sample-rate", help="Sampling rate [Hz].")] = 200.0,
     units: Annotated[str, typer.Option("--units", help="Unit of the written gyro columns.")] = "deg/s",
@@ -130,7 +151,8 @@ def simulate(
     pace: Annotated[float, typer.Option(
         "--pace", help="--device: 1 = real time, 10 = ten times faster, 0 = as fast as the reader reads.")] = 1.0,
 ) -> None:
-    """Simulate a recording (servo, hand, turntable or profile) with its truth sidecar."""
+    """Simulate a recording (servo, hand, turntable, profile, static, or a whole IMU's multi-position hand
+    session) with its truth sidecar."""
     import numpy as np
 
     from ..files import save
@@ -152,7 +174,7 @@ def simulate(
     truth_file = _check_outputs(output, truth_path(output) if output else None, reference, profile, force)
     unit = parse_rate_unit(units)
     rng = np.random.default_rng(seed)
-    sd = noise_std(noise, noise_density, sample_rate, 0.035 if protocol != "turntable" else 0.005)
+    sd = noise_std(noise, noise_density, sample_rate, 0.035 if protocol not in ("turntable", "static") else 0.005)
     model = ScaleBias(triple("--k", k, (1.0, 1.0, 1.0)), triple("--b", b, (0.0, 0.0, 0.0)))
     gyro_kw = dict(noise_std=tuple(sd), bias_instability=bias_instability, rate_random_walk=rate_random_walk,
                    quantum=quantum, full_scale=None if full_scale is None else math.radians(full_scale))
@@ -163,11 +185,14 @@ def simulate(
         rec, facts, true_rates = _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misalignment,
                                         sample_rate, rng, settings)
     elif protocol == "multi-position":
-        rec, model, facts = _multi_position(model, gyro_kw, poses, tilt, still, accel_noise, misalignment,
-                                            sample_rate, rng, settings)
+        density = 0.002 if accel_noise_density is None else accel_noise_density
+        rec, model, facts = _multi_position(model, gyro_kw, poses, tilt, still, density * math.sqrt(sample_rate),
+                                            misalignment, sample_rate, rng, settings)
     elif protocol == "turntable":
         rec, model, facts = _turntable(gyro_kw, _turntable_protocol(temps, rates, step_duration, temp_noise,
                                                                      temp_quantum), sample_rate, rng, settings)
+    elif protocol == "static":
+        rec, facts = _static(gyro_kw, ctx.params, sample_rate, rng, settings)
     else:
         rec, facts, true_rates = _profile(model, gyro_kw, profile, profile_units, duration, sample_rate, rng,
                                           settings)
@@ -302,7 +327,8 @@ def _multi_position(model, gyro_kw, poses, tilt, still, accel_noise, misalignmen
     proto = MultiPositionProtocol(poses=poses, turn_deg=tilt, static_duration=(0.75 * still, 1.25 * still),
                                   sample_rate=sample_rate)
     session = simulate_multi_position(imu, proto, rng=rng)
-    settings.update(poses=poses, tilt_deg=tilt, still_s=still, accel_noise=accel_noise, misalignment_deg=misalignment)
+    settings.update(poses=poses, tilt_deg=tilt, still_s=still, accel_noise_std=accel_noise,
+                    misalignment_deg=misalignment)
     return session_recording(session), gyro, session_facts(session)
 
 
@@ -337,3 +363,35 @@ def _profile(model, gyro_kw, profile, profile_units, duration, sample_rate, rng,
                                        duration=duration, sample_rate=sample_rate, rng=rng)
     settings.update(profile=str(profile), duration_s=duration)
     return rec, {}, true_rates
+
+
+def _static(gyro_kw, flags: dict, sample_rate, rng, settings):
+    """``--protocol static``: a board lying still, warming up when --temp-start and --temp-end differ."""
+    from ..models import ScaleBias
+    from ..simulation import BiasDrift, StillAccelerometer, StillProtocol, VirtualGyro, simulate_still
+
+    if flags["duration"] is None:
+        raise InputError("--protocol static needs --duration SECONDS")
+    tempco = flags["bias_tempco"]
+    rows = [numbers("--bias-tempco", part) for part in (tempco or "0,0,0").split(";")]
+    if any(len(r) != 3 for r in rows):
+        raise InputError(f"--bias-tempco takes triples x,y,z per power of (T - 25 degC), ';' between powers, "
+                         f"got {tempco!r}")
+    drift = BiasDrift([[0.0, *c] for c in zip(*rows)], ref_temp=25.0)
+    proto = StillProtocol(duration=flags["duration"], temp_start=flags["temp_start"], temp_end=flags["temp_end"],
+                          temp_tau=flags["warmup_tau"], temp_noise=flags["temp_noise"],
+                          temp_quantum=flags["temp_quantum"])
+    accel = None
+    if flags["accel_noise_density"] is not None or flags["accel_random_walk"] is not None:
+        accel = StillAccelerometer(flags["accel_noise_density"] or 0.0, flags["accel_random_walk"] or 0.0)
+    gyro = VirtualGyro(ScaleBias([1.0, 1.0, 1.0], [0.0, 0.0, 0.0]), thermal=drift, **gyro_kw)
+    rec, _ = simulate_still(gyro, proto, sample_rate=sample_rate, rng=rng, accel=accel)
+    settings.update(duration_s=proto.duration, temp_noise_degC=proto.temp_noise, temp_quantum_degC=proto.temp_quantum)
+    facts = {"still": {"temp_start_degC": proto.temp_start, "temp_end_degC": proto.temp_end,
+                       "warmup_tau_s": proto.temp_tau,
+                       "bias_tempco": {"ref_temp_degC": 25.0, "coefs": drift.coefs.tolist(),
+                                       "equation": "bias(T) = sum_n coefs[:, n] (T - 25)^n [rad/s]"},
+                       "accelerometer": None if accel is None else {
+                           "noise_density": accel.noise_density, "random_walk": accel.random_walk,
+                           "gravity": [0.0, 0.0, 9.80665]}}}
+    return rec, facts
