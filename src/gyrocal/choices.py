@@ -23,6 +23,7 @@ __all__ = [
     "SaturationPolicy",
     "StudyName",
     "TableModel",
+    "TimeStamps",
     "values",
 ]
 
@@ -42,6 +43,8 @@ OutOfRange = Literal["refuse", "clamp", "extrapolate"]
 TableModel = Literal["lagrange", "smooth", "traditional"]
 #: Motion sources of ``gyrocal simulate`` (see :mod:`gyrocal.simulation`).
 Protocol = Literal["servo", "hand", "turntable", "profile"]
+#: How ``gyrocal simulate`` stamps its samples: on the sensor's clock, or as a PC receiving packets.
+TimeStamps = Literal["sensor", "receive"]
 #: Monte Carlo studies reproducing the papers (see :mod:`gyrocal.studies`).
 StudyName = Literal["servo-normal", "servo-extreme", "servo-speed", "servo-convergence", "thermal-compare"]
 #: Wire formats ``gyrocal capture`` reads ("auto": whichever decodes first; see :mod:`gyrocal.capture`).

@@ -12,7 +12,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from ..choices import DeviceWire, Protocol
+from ..choices import DeviceWire, Protocol, TimeStamps
 from ..errors import InputError
 from ._options import NoiseDensity, given, noise_std, numbers, refuse_unused, triple
 from ._outputs import check_output, json_format, starts_with
@@ -24,7 +24,8 @@ _SIMULATED = "gyrocal simulate"  # first words of a simulated recording: a later
 _SERVO = ("servo", "hand")
 #: Flags that only some protocols use; the rest apply to every protocol.
 _PROTOCOL_FLAGS = {
-    **dict.fromkeys(("speed", "turns", "wait", "ramp", "misalignment"), _SERVO), "vibration": ("servo",),
+    **dict.fromkeys(("speed", "turns", "wait", "ramp", "misalignment", "revolutions"), _SERVO),
+    **dict.fromkeys(("vibration", "ripple", "ripple_freq"), ("servo",)),
     # the turntable gyro follows the full-temperature-range method's thermal truth
     **dict.fromkeys(("k", "b"), (*_SERVO, "profile")),
     **dict.fromkeys(("temps", "rates", "step_duration", "temp_noise", "temp_quantum"), ("turntable",)),
@@ -86,6 +87,20 @@ def simulate(
     temp_quantum: Annotated[Optional[float], typer.Option(
         "--temp-quantum", help="--protocol turntable: resolution of the temperature readings [degC], e.g. 1.")]
     = None,
+    revolutions: Annotated[Optional[str], typer.Option(
+        "--revolutions", help="Servo/hand: revolutions of each turn, one number or one per turn (0.375,0.5,0.75 = "
+                              "135, 180, 270 deg).")] = None,
+    ripple: Annotated[float, typer.Option(
+        "--ripple", help="Servo: sinusoidal speed ripple, amplitude as a fraction of the speed (0.05 = 5 %).")] = 0.0,
+    ripple_freq: Annotated[float, typer.Option("--ripple-freq", help="Servo: frequency of the ripple [Hz].")] = 2.5,
+    stamps: Annotated[TimeStamps, typer.Option(
+        "--stamps", help="Time stamps: the sensor's clock, or receive times of a PC reading packets of two samples "
+                         "(steps of about 3 and 17 ms at 100 Hz).")] = "sensor",
+    late_per_minute: Annotated[float, typer.Option(
+        "--late-per-minute", help="--stamps receive: late packets per minute (a long step caught up by a burst; "
+                                  "nothing lost).")] = 0.0,
+    gaps: Annotated[int, typer.Option("--gaps", help="Packet gaps: runs of samples never delivered.")] = 0,
+    gap_length: Annotated[float, typer.Option("--gap-length", help="Length of each gap [s].")] = 0.17,
     sample_rate: Annotated[float, typer.Option("--sample-rate", help="Sampling rate [Hz].")] = 200.0,
     units: Annotated[str, typer.Option("--units", help="Unit of the written gyro columns.")] = "deg/s",
     seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
@@ -140,12 +155,15 @@ def simulate(
         from ..simulation.truth import servo_facts
 
         turn_list = tuple(t.strip() for t in turns.split(",") if t.strip())
-        kw = dict(speed=math.radians(speed), wait=wait, ramp=ramp, misalignment_deg=misalignment)
+        revs = 1.0 if revolutions is None else tuple(numbers("--revolutions", revolutions))
+        kw = dict(speed=math.radians(speed), wait=wait, ramp=ramp, misalignment_deg=misalignment,
+                  revolutions=revs[0] if isinstance(revs, tuple) and len(revs) == 1 else revs)
         proto = (ServoProtocol.hand(turn_list, **kw) if protocol == "hand"
-                 else ServoProtocol(turns=turn_list, vibration=vibration, **kw))
+                 else ServoProtocol(turns=turn_list, vibration=vibration, ripple=ripple, ripple_freq=ripple_freq, **kw))
         rec, truth = simulate_servo(VirtualGyro(model, **gyro_kw), proto, sample_rate=sample_rate, rng=rng)
         settings.update(speed_deg_s=speed, turns=list(turn_list), wait_s=wait, ramp_s=ramp, vibration=vibration,
-                        misalignment_deg=misalignment)
+                        misalignment_deg=misalignment, revolutions=[float(r) for r in proto.turn_angles() / (2 * math.pi)],
+                        ripple=ripple, ripple_freq_hz=ripple_freq)
         facts = servo_facts(truth)
     elif protocol == "turntable":
         from ..models import Affine
@@ -171,10 +189,34 @@ def simulate(
         rec, _ = simulate_profile(VirtualGyro(model, **gyro_kw), read_profile(profile, units=profile_units),
                                   duration=duration, sample_rate=sample_rate, rng=rng)
         settings.update(profile=str(profile), duration_s=duration)
+    if stamps == "receive" or gaps:
+        rec, facts = _time_defects(rec, facts, settings, stamps, late_per_minute, gaps, gap_length, rng)
+    elif given(ctx, "late_per_minute"):
+        raise InputError("--late-per-minute is for --stamps receive; add it or leave --late-per-minute out")
     write_recording(output, rec, units=unit,
                     header_comment=f"{_SIMULATED} --protocol {protocol}; gyro in {unit}, t in s")
     save(SimulationTruth(protocol=protocol, model=model, settings=settings, facts=facts), truth_file)
     console.print(f"wrote {output} ({len(rec)} samples, {len(rec) / sample_rate:.1f} s, {unit}) and {truth_file}")
+
+
+def _time_defects(rec, facts: dict, settings: dict, stamps: str, late_per_minute: float, gaps: int,
+                  gap_length: float, rng):
+    """Receive-time stamps and packet gaps on a simulated recording; truth windows moved to its rows."""
+    from ..simulation.timestamps import ReceiveClock, rows_after_gaps, with_time_defects
+
+    if gaps < 0 or not gap_length > 0:
+        raise InputError(f"--gaps must be >= 0 and --gap-length > 0 s, got {gaps} and {gap_length:g}")
+    clock = ReceiveClock(late_per_minute=late_per_minute) if stamps == "receive" else None
+    out, truth = with_time_defects(rec, rng, clock=clock, gaps=gaps, gap_length=gap_length)
+    settings.update(stamps=stamps, late_per_minute=late_per_minute, gaps=gaps, gap_length_s=gap_length)
+    moved = dict(facts)
+    for key in ("windows", "plateaus"):
+        if key in moved:
+            moved[key] = [{**w, "start": int(rows_after_gaps(w["start"], truth["gaps"])),
+                           "stop": int(rows_after_gaps(w["stop"], truth["gaps"]))} for w in moved[key]]
+    moved["time_base"] = {**truth, "note": "gaps: [first missing sample of the sensor clock, count]; windows and "
+                                           "plateaus are rows of the recording"}
+    return out, moved
 
 
 def _serve_device(protocol, speed, turns, wait, misalignment, k, b, noise, noise_density, sample_rate, seed, wire,

@@ -20,7 +20,7 @@ from .._validation import positive
 from ..errors import InputError
 from ..recording import Recording
 
-__all__ = ["ReceiveClock", "drop_samples", "receive_times", "with_time_defects"]
+__all__ = ["ReceiveClock", "drop_samples", "receive_times", "rows_after_gaps", "with_time_defects"]
 
 
 @dataclass(frozen=True)
@@ -148,3 +148,16 @@ def with_time_defects(
         extra={k: np.asarray(v)[keep] for k, v in rec.extra.items()}, sensitivity=rec.sensitivity,
     )
     return out, truth
+
+
+def rows_after_gaps(index, gaps) -> np.ndarray:
+    """Rows of the recording with gaps that original sample numbers `index` became.
+
+    `gaps` is the truth's ``[[first missing original sample, count], ...]``; a sample inside a
+    gap maps to the first row after it.
+    """
+    idx = np.asarray(index, dtype=np.int64)
+    shift = np.zeros_like(idx)
+    for start, count in gaps:
+        shift += np.clip(idx - start, 0, count)
+    return idx - shift
