@@ -287,7 +287,7 @@ def calibrate(
                       declared=value if windows is None or reference == "speed" else math.nan,
                       sample_rate=rec.sample_rate, has_time=rec.has_time, sensitivity=rec.sensitivity)
         plausible, notes = check_plausibility(fit.model.k, ctx)
-        warnings = list(quality.warnings) + plausible
+        warnings = list(quality.warnings) + _single_turns(used, reference, value) + plausible
     cal = Calibration(
         model=fit.model,
         input_units=input_units,
@@ -316,6 +316,20 @@ def _observed(rec: Recording, tb: TimeBase, noise_std, input_scale: float, input
     return {"sample_rate": rec.sample_rate, "units": input_units,
             "noise_std": (np.asarray(noise_std, dtype=float) / input_scale).tolist(),
             "max_abs_rate": (peak / input_scale).tolist(), "time_base": tb.to_document()}
+
+
+def _single_turns(windows: Sequence[Window], reference: str, declared: float) -> list[str]:
+    """A warning when some scale factor rests on one turn: its residual is zero, nothing checks it."""
+    turns = [w.axis for w in windows if w.kind == "rotation"]
+    alone = [a for a in "xyz" if turns.count(a) == 1]
+    if not alone:
+        return []
+    deg = math.degrees(declared)
+    what = (f"their declared angle (1 deg in {deg:g} is {1 / deg:.2g} in k)" if reference == "angle"
+            else "their declared speed")
+    return [f"the scale factor{'s' if len(alone) > 1 else ''} of {', '.join(alone)} rest{'' if len(alone) > 1 else 's'} "
+            f"on one turn each: nothing in the data checks {what}; turn both ways or repeat the turns so that the "
+            "fit can check itself"]
 
 
 def _label(w: Window) -> str:

@@ -213,7 +213,8 @@ def _find_gaps(r: np.ndarray, step: np.ndarray, period: float, floor: np.ndarray
     (a low quantile, so that a few delayed samples at a gap's edge do not count) just before and
     just after it, with the gaps already found taken out: the longest steps first, then the shorter
     ones in time order, so that a burst's long step right after a real gap is judged with that gap
-    removed. A step must also be long enough to hold the samples it lost.
+    removed. A step must also be long enough to hold the samples it lost (counting the delay of
+    the sample before it, which shortens the step).
     """
     rise = np.flatnonzero(np.diff(floor) >= 0.5 * period)
     if not len(rise):
@@ -230,8 +231,11 @@ def _find_gaps(r: np.ndarray, step: np.ndarray, period: float, floor: np.ndarray
     for i in order.tolist():
         lo, hi = max(0, i - size + 1), min(n, i + 1 + size)
         adj = r[lo:hi] - period * np.cumsum(lost_at[lo:hi])  # levels relative within the window
-        lost = int(np.rint((_floor(adj[i + 1 - lo:]) - _floor(adj[: i + 1 - lo])) / period))
-        if 1 <= lost <= int(np.rint(step[i] / period)):
+        before = _floor(adj[: i + 1 - lo])
+        lost = int(np.rint((_floor(adj[i + 1 - lo:]) - before) / period))
+        # the step from a late sample is short by that sample's delay: count it in the room
+        room = int(np.rint((step[i] + max(0.0, adj[i - lo] - before)) / period))
+        if 1 <= lost <= room:
             lost_at[i + 1] = lost
     found = np.flatnonzero(lost_at)
     return [Gap(int(j), float(step[j - 1]), int(lost_at[j])) for j in found]
@@ -263,7 +267,15 @@ def analyse_time(t, *, has_time: bool = True) -> TimeBase:
         size = _block_size(period, len(t))
         floor, at = _floors(r, size)
         gaps = _find_gaps(r, step, period, floor, size)
-        clock = _fit_clock(t, period, floor, at, gaps)
+        k = None
+        if gaps:  # the envelope again, with the lost samples counted (a block may straddle a gap)
+            lost = np.zeros(len(t))
+            for g in gaps:
+                lost[g.index] = g.lost
+            lost = np.cumsum(lost)
+            floor, at = _floors(r - period * lost, size)
+            k = at + lost[at]
+        clock = _fit_clock(t, period, floor, at if k is None else k)
         if gaps:
             keep = np.ones(len(sample), dtype=bool)
             keep[np.isin(np.linspace(0, len(step) - 1, len(sample)).astype(np.intp), [g.index - 1 for g in gaps])] = 0
@@ -284,22 +296,17 @@ def analyse_time(t, *, has_time: bool = True) -> TimeBase:
     )
 
 
-def _fit_clock(t: np.ndarray, period: float, floor: np.ndarray, at: np.ndarray,
-               gaps: list[Gap]) -> tuple[float, float] | None:
+def _fit_clock(t: np.ndarray, period: float, floor: np.ndarray, k: np.ndarray) -> tuple[float, float] | None:
     """``(start, period)`` of the regular clock under stamps `t`, or None.
 
-    The lower envelope of ``t - k P`` (`floor`: the least-delayed sample of each block, at sample
-    `at`), with the samples lost in `gaps` counted in the clock number k, is fitted by a line; the
-    clock is regular when the envelope stays within half a period of it.
+    The lower envelope of ``t - k P`` (`floor`: the least-delayed sample of each block, at clock
+    number `k`: its index plus the samples lost before it) is fitted by a line; the clock is
+    regular when the envelope stays within half a period of it.
     """
-    lost = np.zeros(len(at))
-    for g in gaps:
-        lost += g.lost * (at >= g.index)
-    env, k = floor - period * lost, at + lost
-    if len(env) < 2:
+    if len(floor) < 2:
         return float(t[0]), period
-    slope, icept = np.polyfit(k, env, 1)
-    resid = env - (icept + slope * k)
+    slope, icept = np.polyfit(k, floor, 1)
+    resid = floor - (icept + slope * k)
     if float(resid.max() - resid.min()) >= 0.5 * period:
         return None
     return float(t[0] + icept), float(period + slope)
