@@ -127,6 +127,9 @@ class CalibrationRun:
             lines.append(f"  noise std per sample [{cal.input_units}]: " + "  ".join(f"{v:.3g}" for v in noise))
         if (note := self.scale_bias_note()) is not None:
             lines.append("  note: " + note)
+        if self.quality is not None:
+            lines.append(self.quality.summary())
+        lines += [f"note: {n}" for n in self.notes] + [f"warning: {w}" for w in self.warnings]
         return "\n".join(lines)
 
 
