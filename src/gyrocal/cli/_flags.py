@@ -76,6 +76,7 @@ FLAGS: dict[str, str] = {
     "ref_noise_std": "--ref-noise",
     "ref_units": "--ref-units",
     "ref_columns": "--ref-columns",
+    "ref_skip_rows": "--ref-skip-rows",
     "ref_sample_rate": "--ref-sample-rate",
     "ref_sensitivity": "--ref-sensitivity",
     "ref_topic": "--ref-topic",
