@@ -104,10 +104,9 @@ def reference_csv_text(rec) -> str:
     return "t,gx,gy,gz\n" + rows + "\n"
 
 
-def generate() -> dict[str, str]:
-    """File name -> content of every bundled example file."""
+def testing_period():
+    """The paper's testing period: the repeated session, its truth, the reference log and its truth."""
     gyro, protocol, fs = example_setup()
-    rec, truth = simulate_servo(gyro, protocol, sample_rate=fs, rng=np.random.default_rng(SEED))
     rng = np.random.default_rng(REPEAT_SEED)
     repeat, repeat_truth = simulate_servo(gyro, protocol, sample_rate=fs, rng=rng)
     ref_gyro = VirtualGyro(model=ScaleBias(k=(1.0, 1.0, 1.0), b=(0.0, 0.0, 0.0)),
@@ -115,6 +114,14 @@ def generate() -> dict[str, str]:
     ref, ref_truth = simulate_reference(repeat.t, repeat_truth.rates, ref_gyro, sample_rate=REF_RATE,
                                         time_offset_s=REF_OFFSET_S, clock_drift_ppm=REF_DRIFT_PPM,
                                         mounting_deg=REF_MOUNTING_DEG, rng=rng)
+    return repeat, repeat_truth, ref, ref_truth
+
+
+def generate() -> dict[str, str]:
+    """File name -> content of every bundled example file."""
+    gyro, protocol, fs = example_setup()
+    rec, truth = simulate_servo(gyro, protocol, sample_rate=fs, rng=np.random.default_rng(SEED))
+    repeat, repeat_truth, ref, ref_truth = testing_period()
     reference = {"path": "example_servo_reference.csv", "units": "deg/s", **ref_truth.to_dict()}
     return {
         "example_servo.csv": csv_text(rec),

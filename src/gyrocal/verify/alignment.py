@@ -34,7 +34,7 @@ from .whitenoise import second_difference_noise
 
 __all__ = ["Alignment", "AlignmentError", "align"]
 
-MIN_MAGNITUDE_SNR = 5.0  # rate-magnitude variation over the noise, each log
+MIN_MAGNITUDE_SNR = 3.0  # rate-magnitude variation over the per-sample noise, each log (static: about 0.7)
 MIN_PEAK = 0.3  # normalised magnitude correlation at the chosen offset
 MIN_ROTATION_SNR = 5.0  # rate RMS across the main turning direction over the noise
 MAX_ROTATION_STD_DEG = 2.0

@@ -41,7 +41,7 @@ from .bootstrap import optimal_block_length
 __all__ = ["Refined", "interpolate", "refine", "smooth_slope"]
 
 PPM = 1e-6
-_CHUNK = 1 << 20
+_CHUNK = 1 << 18  # samples per pass of the normal equations: a (n, 3, 5) Jacobian of 31 MB
 _MAX_ITER = 50
 #: Width of the derivative filter behind the time columns of the Jacobian [s].
 SLOPE_WIDTH_S = 0.05
