@@ -247,6 +247,8 @@ def calibrate(
     InputError
         For Algorithm 1 and LM, a rotation window whose rate varies (ramps, hand turns).
     """
+    # long function: the pipeline's steps in the order they run (references, segmentation, time base,
+    # observations, fit, checks, file sections), each already a call of its own
     if (speed is None) == (angle is None):
         raise InputError(f"give exactly one of speed [rad/s] or angle [rad], got speed={speed!r}, angle={angle!r}")
     reference = "speed" if speed is not None else "angle"

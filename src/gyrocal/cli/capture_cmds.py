@@ -219,6 +219,11 @@ def _finish(result, port, units, sensitivity, sample_rate, guided, cal_path, spe
     elif guided is not None:
         warn(f"the guided session stopped at step {guided.guide.index + 1} of {len(guided.guide.steps)}; "
              "no calibration written (the recording is complete)")
+    else:
+        how = f"--units {units}" + (f" --sensitivity {sens:g}" if units == "counts" and sens else "")
+        how += "" if result.store.has_time else f" --sample-rate {sample_rate:g}" if sample_rate else " --sample-rate HZ"
+        console.print(f"next: gyrocal calibrate {result.path} {how} --angle 360 -o cal.json", highlight=False,
+                      soft_wrap=True, markup=False)
     agreement = device_check(result)
     if agreement is None:
         return
