@@ -1,4 +1,4 @@
-"""Batch speed of the six-observation estimators (issue 2: >= 1,000,000 calibrations/s).
+"""Batch speed of the six-observation estimators (target >= 1,000,000 calibrations/s, README's measured figures).
 
 Run by hand:  .venv/bin/python bench/bench_batch.py [--batch 1000000] [--repeat 3]
 

@@ -15,7 +15,6 @@ from __future__ import annotations
 import argparse
 import math
 import multiprocessing as mp
-import struct
 import tempfile
 import time
 from pathlib import Path

@@ -18,10 +18,10 @@ import time
 
 import numpy as np
 
+from gyrocal.simulation.fast import simulate_observations
 from gyrocal.studies import run_study
 from gyrocal.studies._common import ServoSettings, draw_truth, fit_errors
 from gyrocal.studies.servo_speed import PAPER_SPEEDS
-from gyrocal.simulation.fast import simulate_observations
 
 
 def per_sample_time(subset: int, settings: ServoSettings) -> float:

@@ -17,10 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from gyrocal.io import write_csv
+from gyrocal.io import read_session, write_csv
 from gyrocal.simulation.thermal_truth import ThermalTruth
 from gyrocal.simulation.turntable import TurntableProtocol, simulate_turntable
-from gyrocal.io import read_session
 from gyrocal.thermal import calibrate_thermal
 from gyrocal.thermal.fit import kg_eq19
 

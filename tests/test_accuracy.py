@@ -1,4 +1,4 @@
-"""Accuracy at the servo method's normal simulation conditions (issue 2, "what it must reach").
+"""Accuracy at the servo method's normal simulation conditions (docs/core.md, "Accuracy at the paper's normal conditions").
 
 2,000 seeded gyros: k ~ U(0.8, 1.2), b ~ U(-0.1, 0.1) rad/s, 200 Hz, 60 deg/s, 0.035 rad/s
 noise, 5 % speed jitter, tilts up to 0.1 rad, one revolution per window.
@@ -45,7 +45,7 @@ def test_first_moment_rms_meets_its_covariance_and_the_crb(trials):
     # RMS over 2,000 trials has a relative sd of 1/sqrt(2N) = 1.6 %: 10 % is a real test
     np.testing.assert_allclose(rms / predicted, 1.0, atol=0.10)
     np.testing.assert_allclose(rms / crb, 1.0, atol=0.10)
-    assert rms[:3].mean() == pytest.approx(0.72e-3, rel=0.05)  # SPEC's figure
+    assert rms[:3].mean() == pytest.approx(0.72e-3, rel=0.05)  # the Cramer-Rao bound sigma/sqrt(N) k^2/(sqrt 2 w) of docs/core.md
 
 
 def test_paper_formulation_scale_bias_has_the_predicted_sign_and_size(trials):
@@ -65,7 +65,7 @@ def test_paper_formulation_scale_bias_has_the_predicted_sign_and_size(trials):
         err = fit.k - k
         se = err.std(axis=0) / math.sqrt(N)
         assert np.all(np.abs(err.mean(axis=0) - predicted.mean(axis=0)) < 4 * se)
-        assert np.all(err.mean(axis=0) < -2.5e-3) and np.all(err.mean(axis=0) > -3.5e-3)  # SPEC: about -3e-3
+        assert np.all(err.mean(axis=0) < -2.5e-3) and np.all(err.mean(axis=0) > -3.5e-3)  # docs/core.md: about -3e-3
         assert np.all(-err.mean(axis=0) / err.std(axis=0) > 2.5)  # ~3 of its own standard deviations
         # the biases are unaffected to first order
         eb = fit.b - b
@@ -76,7 +76,7 @@ def test_first_moment_beats_the_paper_formulation(trials):
     k, _, obs = trials
     rms_fm = np.sqrt(((first_moment_batch(obs).k - k) ** 2).mean())
     rms_a1 = np.sqrt(((algorithm1_batch(obs).k - k) ** 2).mean())
-    assert rms_a1 / rms_fm > 3.5  # SPEC: "about 4x"; measured 4.3
+    assert rms_a1 / rms_fm > 3.5  # docs/core.md: about 4x; measured 4.3
 
 
 @pytest.mark.parametrize("fit", [algorithm1_batch, paper_lm_batch], ids=["algorithm1", "lm"])

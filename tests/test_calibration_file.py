@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from gyrocal.calibration import Calibration
-from gyrocal.files import from_document, load_calibration, save_calibration
 from gyrocal.errors import FileFormatError
+from gyrocal.files import from_document, load_calibration, save_calibration
 from gyrocal.models import Affine, ScaleBias
 
 

@@ -75,7 +75,7 @@ def test_turn_about_another_axis_is_refused():
 
 def test_hand_session_with_a_redo():
     rng = np.random.default_rng(163)
-    proto = ServoProtocol.hand(turns=("+x", "+y", "+y", "+z"), lead_in=3.0, wait=3.0, lead_out=3.0)
+    proto = ServoProtocol.hand(turns=("+x", "+y", "+y", "+z"), lead_in=3.0, wait=4.0, lead_out=4.0)
     s = simulate_device_session(proto, model=MODEL, noise_std=0.01, rng=rng)
     guide = Guide("hand")
     # after the first +y is accepted the person asks to redo it, and does it again
@@ -95,3 +95,15 @@ def test_guides_are_the_papers_sessions():
     assert [st.label for st in GUIDES["hand"] if st.kind == "turn"] == ["+x", "+y", "+z"]
     with pytest.raises(Exception, match="guide must be one of"):
         Guide("robot")
+
+
+def test_servo_session_with_a_known_speed():
+    """With --speed the turns are judged as constant-speed plateaus (the speed reference of calibrate)."""
+    rng = np.random.default_rng(164)
+    s = simulate_device_session(ServoProtocol(lead_in=3.0), model=MODEL, noise_std=0.01, rng=rng)
+    guide = Guide("servo", speed=math.radians(60.0))
+    events = play(guide, s)
+    assert guide.complete and not [e for e in events if e.kind == "refused"]
+    run = calibrate(as_recording(s), speed=math.radians(60.0), windows=guide.windows())
+    sigma = np.sqrt(np.diag(run.calibration.covariance))
+    assert np.all(np.abs(run.calibration.model.params - MODEL.params) <= 4 * sigma)

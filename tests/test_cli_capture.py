@@ -119,7 +119,7 @@ def test_guided_servo_session_with_the_device_answer(tmp_path, servo):
 
 def test_guided_hand_session_with_a_redo(tmp_path):
     rng = np.random.default_rng(1602)
-    proto = ServoProtocol.hand(turns=("+x", "+y", "+y", "+z"), lead_in=3.0, wait=3.0, lead_out=3.0)
+    proto = ServoProtocol.hand(turns=("+x", "+y", "+y", "+z"), lead_in=3.0, wait=4.0, lead_out=4.0)
     s = simulate_device_session(proto, model=MODEL, noise_std=0.01, rng=rng)
     data = device_bytes(s, "frames", encoder="python")
     pause = s.turns[1].stop + int(2.0 * s.sample_rate)  # 2 s into the stillness after the first +y

@@ -8,9 +8,9 @@ import re
 from pathlib import Path
 
 import typer
+from cli_runner import invoke, refused
 
 import gyrocal
-from cli_runner import invoke, refused
 from gyrocal.cli import app
 from gyrocal.cli._flags import FLAGS, NOT_FLAGS, flag
 from gyrocal.errors import ConvergenceError, FileFormatError, GyrocalError, InputError, OutOfRangeError
@@ -29,6 +29,9 @@ def test_render_fills_in_the_name_of_the_caller():
     assert ConvergenceError("stuck", 7, param="method").iterations == 7
     assert FileFormatError("bad", "units.input").field == "units.input"
     assert isinstance(InputError("x"), ValueError) and isinstance(InputError("x"), GyrocalError)
+    both = InputError("no column for gx", param="columns", hint="map it with {param} gx=NAME, or {param:skip_rows} N")
+    assert str(both) == "no column for gx; map it with columns gx=NAME, or skip_rows N"
+    assert both.render(flag) == "no column for gx; map it with --columns gx=NAME, or --skip-rows N"
 
 
 def _all_flags() -> set[str]:
@@ -51,7 +54,9 @@ def test_every_parameter_the_library_names_has_a_flag_or_is_declared_flagless():
     for path in SRC.rglob("*.py"):
         if "cli" in path.parts:
             continue
-        named.update(re.findall(r"""\bparam=["']([A-Za-z_][\w.]*)["']""", path.read_text()))
+        text = path.read_text()
+        named.update(re.findall(r"""\bparam=["']([A-Za-z_][\w.]*)["']""", text))
+        named.update(re.findall(r"\{param:([A-Za-z_]\w*)\}", text))
     unknown = named - set(FLAGS) - NOT_FLAGS
     assert not unknown, f"add these to gyrocal/cli/_flags.py: {sorted(unknown)}"
 

@@ -189,7 +189,7 @@ def test_results_are_frozen(rng):
             getattr(fit, name)[0] = 0
 
 
-# --- errors (issue 2, item 5) ---
+# --- errors: one sentence naming the argument (docs/core.md, Estimators) ---
 
 
 def test_all_rotations_about_one_axis_is_degenerate(rng):

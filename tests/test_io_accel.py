@@ -8,8 +8,8 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
-
 from cli_runner import invoke, refused
+
 from gyrocal.calibration import Calibration
 from gyrocal.errors import InputError, UnitError
 from gyrocal.files import save

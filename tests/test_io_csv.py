@@ -160,13 +160,16 @@ def test_missing_file(tmp_path):
 def test_missing_column_lists_columns_and_suggests_mapping(tmp_path):
     path = write_table(tmp_path / "m.csv", ["t", "gyroA", "gyroB", "gyroC"], [[0, 1, 2, 3]])
     msg = bad(path, "no column for gx, gy, gz")
-    assert "'gyroA'" in msg and "--columns" in msg
+    assert "'gyroA'" in msg and "map them with columns gx=NAME" in msg
+    with pytest.raises(InputError) as info:
+        read_recording(path, units="deg/s")
+    assert info.value.param == "columns"
     bad(path, r"column 'gyroQ' \(given for gx\) is not in the file", columns={"gx": "gyroQ"})
 
 
 def test_ambiguous_alias_asks_for_mapping(tmp_path):
     path = write_table(tmp_path / "amb.csv", ["t", "gyr_x", "gyro_x", "gy", "gz"], [[0, 1, 2, 3, 4]])
-    bad(path, "several columns could be gx .*--columns gx=gyr_x")
+    bad(path, "several columns could be gx .*say which with columns gx=gyr_x")
 
 
 @pytest.mark.parametrize("use_pyarrow", [True, False])
@@ -194,7 +197,7 @@ def test_time_must_increase(tmp_path):
 
 
 def test_missing_time_needs_sample_rate(tmp_path):
-    bad(write_table(tmp_path / "nt.csv", ["gx", "gy", "gz"], [[1, 2, 3], [1, 2, 3]]), "no time column.*--sample-rate")
+    bad(write_table(tmp_path / "nt.csv", ["gx", "gy", "gz"], [[1, 2, 3], [1, 2, 3]]), "no time column.*give the sample rate \\(sample_rate HZ\\)")
 
 
 def test_saturated_samples(tmp_path, rng):
@@ -211,7 +214,7 @@ def test_saturated_samples(tmp_path, rng):
 def test_deg_s_declared_as_rad_s(tmp_path, rng):
     g = rates(rng, 100, scale=300.0)
     write_csv(tmp_path / "u.csv", {"t": np.arange(100) * 0.01, "gx": g[:, 0], "gy": g[:, 1], "gz": g[:, 2]})
-    bad(tmp_path / "u.csv", "almost surely in deg/s: use --units deg/s", UnitError, units="rad/s")
+    bad(tmp_path / "u.csv", "almost surely in deg/s: use units deg/s", UnitError, units="rad/s")
     assert len(read_recording(tmp_path / "u.csv", units="rad/s", check_units=False)) == 100
 
 
@@ -221,7 +224,7 @@ def test_counts_must_be_integers_and_counts_are_not_deg_s(tmp_path, rng):
     bad(tmp_path / "f.csv", "units are counts but data row 1 holds non-integer", UnitError, units="counts", sample_rate=10)
     c = np.round(g * 400)
     write_csv(tmp_path / "c.csv", {"gx": c[:, 0], "gy": c[:, 1], "gz": c[:, 2]})
-    bad(tmp_path / "c.csv", "look like raw counts: use --units counts", UnitError, sample_rate=10)
+    bad(tmp_path / "c.csv", "look like raw counts: use units counts", UnitError, sample_rate=10)
 
 
 def test_bad_arguments(tmp_path):
@@ -229,7 +232,7 @@ def test_bad_arguments(tmp_path):
     bad(path, "units='furlongs' is not a known unit", UnitError, units="furlongs", sample_rate=1)
     bad(path, "sensitivity=16.4 applies only to units='counts'", UnitError, sample_rate=1, sensitivity=16.4)
     bad(path, "sample_rate must be finite and > 0", sample_rate=-5)
-    bad(path, "saturation='keep' is not accepted", sample_rate=1, saturation="keep")
+    bad(path, "saturation 'keep' is not accepted", sample_rate=1, saturation="keep")
     bad(path, "columns key 'gq' is not a known quantity", columns="gq=gx")
     bad(path, "columns entry 'gx' is not NAME=COLUMN", columns="gx")
 

@@ -76,7 +76,7 @@ def test_real_data_in_rad_s_pass_the_unit_checks_and_in_deg_s_fail(tmp_path, nam
     rec = read_recording(tmp_path / "rad.csv", units="rad/s")
     np.testing.assert_allclose(rec.gyro, np.radians(deg), rtol=1e-15)
     write_csv(tmp_path / "deg.csv", table("t", t, deg))
-    bad(tmp_path / "deg.csv", "almost surely in deg/s: use --units deg/s", UnitError, units="rad/s")
+    bad(tmp_path / "deg.csv", "almost surely in deg/s: use units deg/s", UnitError, units="rad/s")
 
 
 def test_slow_deg_s_data_declared_as_rad_s_are_caught_by_their_noise(tmp_path, rng):
@@ -84,7 +84,7 @@ def test_slow_deg_s_data_declared_as_rad_s_are_caught_by_their_noise(tmp_path, r
     still = deg[:200]  # the example's static start: 8 deg/s at most, under the peak check's 34.9
     assert np.abs(still).max() < 34.9
     write_csv(tmp_path / "still.csv", table("t", t[:200], still))
-    bad(tmp_path / "still.csv", r"per-sample noise is [12]\.\d+ rad/s.*use --units deg/s \(or --no-unit-check\)",
+    bad(tmp_path / "still.csv", r"per-sample noise is [12]\.\d+ rad/s.*use units deg/s \(or check_units\)",
         UnitError, units="rad/s")
     assert len(read_recording(tmp_path / "still.csv", units="rad/s", check_units=False)) == 200
     # slow turns, +-20 deg/s, with MEMS noise
@@ -101,7 +101,7 @@ def test_headerless_file_asks_for_columns_by_number(tmp_path, delimiter, example
     rows = ["0 -0.21 0.05 0.33", "0.01 -0.2 0.04 0.31", "0.02 -0.22 0.06 0.3"]
     (tmp_path / "h.csv").write_text("\n".join(r.replace(" ", delimiter) for r in rows) + "\n")
     msg = bad(tmp_path / "h.csv", r"the first line \('0.-0\.21.*'\) is data, not a header; say which column holds "
-              r"what by number, counting from 1 \(--columns t=1,gx=2,gy=3,gz=4\)")
+              r"what by number, counting from 1 \(columns t=1,gx=2,gy=3,gz=4\)")
     assert example in msg
     # the advice works: the first column increases, so it is offered as the time
     rec = read_recording(tmp_path / "h.csv", units="deg/s", columns="t=1,gx=2,gy=3,gz=4")
@@ -136,7 +136,6 @@ def test_utf16_and_utf32_text_with_a_bom_is_decoded(tmp_path, use_pyarrow, encod
 
 
 def test_cli_refuses_each_in_one_line(tmp_path, rng):
-    pytest.importorskip("typer")
     from cli_runner import refused
 
     g = rng.normal(0, 2.0, (50, 3))
@@ -157,6 +156,6 @@ def test_numbered_header_of_pandas_is_a_header_and_its_names_win_over_positions(
     assert len(rec) == 50 and rec.sample_rate == pytest.approx(100.0)
     np.testing.assert_allclose(np.degrees(rec.gyro[:3, 0]), [0.0, 0.1, 0.2], rtol=1e-12)
     bad(path, r"the header \('0,1,2,3'\) numbers the columns from 0, as pandas writes them; say which column holds "
-        r"what by those names, e.g. --columns t=0,gx=1,gy=2,gz=3")
+        r"what by those names, e.g. columns t=0,gx=1,gy=2,gz=3")
     # positions counted from 1 would collide with the names: refused, never read shifted
     bad(path, r"column '3' is given for both gy and gz", columns="t=1,gx=2,gy=3,gz=4")

@@ -172,7 +172,7 @@ def test_skip_rows_places_the_header_and_the_message_suggests_it(tmp_path, rng):
     lead = "sensor,gyro,range,2000\n0,1,2,3\n"
     (tmp_path / "pre.csv").write_text(lead + _text(t, g))
     msg = refused(tmp_path / "pre.csv", r"no column for gx, gy, gz; columns found \(header on line 1\): 'sensor'")
-    assert "skip the lines above it (skip_rows=N)" in msg
+    assert "skip the lines above it with skip_rows N" in msg
     rec = read_recording(tmp_path / "pre.csv", units="deg/s", skip_rows=2)
     np.testing.assert_array_equal(rec.t, t)
     with pytest.raises(InputError, match=r"skip_rows must be a whole number >= 0, got -1"):
@@ -198,9 +198,9 @@ def test_headerless_table_by_column_number(tmp_path, rng, delimiter, use_pyarrow
     rec = read_recording(tmp_path / "serial.txt", units="deg/s", columns={"gx": 3, "gy": 4, "gz": 5}, sample_rate=200)
     assert rec.has_time is False and list(rec.extra) == ["1", "2"]
     refused(tmp_path / "serial.txt", r"column '7' \(given for gz\) is not in the file; columns found \(no header "
-            r"row; columns count from 1\): '1', '2', '3', '4', '5'; give a name or a number from 1 to 5",
+            r"row; columns count from 1\): '1', '2', '3', '4', '5'; in columns, give a name or a number from 1 to 5",
             columns="gx=3,gy=4,gz=7")
-    refused(tmp_path / "serial.txt", r"no column for gz; .*by number, e\.g\. --columns gx=2,gy=3,gz=4",
+    refused(tmp_path / "serial.txt", r"no column for gz; .*give them by number, e\.g\. columns gx=2,gy=3,gz=4",
             columns="gx=3,gy=4")
 
 
@@ -208,7 +208,7 @@ def test_headerless_without_time_suggests_the_sample_rate(tmp_path, rng):
     _, g = _table(rng)
     (tmp_path / "g.txt").write_text("\n".join(" ".join(f"{v:.4f}" for v in row) for row in g) + "\n")
     msg = refused(tmp_path / "g.txt", r"is data, not a header; say which column holds what by number, counting "
-                  r"from 1 \(--columns gx=1,gy=2,gz=3 with --sample-rate HZ\)")
+                  r"from 1 \(columns gx=1,gy=2,gz=3 with sample_rate HZ\)")
     assert "'t gx gy gz'" in msg
 
 

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from cli_runner import invoke
+
 from gyrocal.calibration import Calibration
 from gyrocal.errors import FileFormatError
 from gyrocal.files import load

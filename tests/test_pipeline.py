@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from gyrocal.files import load_calibration, save_calibration
 from gyrocal.errors import InputError, SegmentationError
+from gyrocal.files import load_calibration, save_calibration
 from gyrocal.models import ScaleBias
 from gyrocal.pipeline import CalibrationRun, calibrate
 from gyrocal.recording import Recording
@@ -81,7 +81,7 @@ def test_counts_without_sensitivity_calibrate_to_output_units(rng):
     assert (cal.input_units, cal.output_units, cal.internal_units) == ("counts", "deg/s", "counts")
     # In user units the scale is deg/s per count: K / lsb, and the offset is -b in counts.
     (_, value, sigma, unit), *_ = run.parameters()
-    assert unit == "deg/s per counts"
+    assert unit == "deg/s per count"
     assert abs(value - K[0] / lsb) < 4 * sigma
     matrix, offset = cal.correction
     np.testing.assert_allclose(np.diag(matrix), [p[1] for p in run.parameters()[:3]])
@@ -137,7 +137,7 @@ def test_paper_methods_use_the_six_rotations_only(method, rng):
     run = calibrate(rec, speed=SPEED, method=method)
     assert [w["kind"] for w in run.calibration.windows] == ["rotation"] * 6
     assert run.calibration.method == method and run.calibration.std is not None
-    # Their mean-of-squares form is biased low by about sum k^2 sigma^2 / (2 omega^2) (SPEC): 3k * 0.035^2 / 2.2
+    # Their mean-of-squares form is biased low by about sum k^2 sigma^2 / (2 omega^2) (docs/core.md, Accuracy): 3k * 0.035^2 / 2.2
     assert np.all(np.abs(run.fit.model.k - K) < 5e-3)
     assert "reads k low by about 0.0017" in run.report()
 
@@ -229,6 +229,6 @@ def test_random_sessions_find_every_turn_and_the_truth(rng):
 def test_turns_too_short_for_a_plateau_point_to_the_angle_reference(rng):
     fast = ServoProtocol(speed=math.radians(300.0))
     rec, _ = simulate_servo(GYRO, fast, sample_rate=FS, rng=rng)
-    with pytest.raises(SegmentationError, match=r"6 no plateau.*calibrate with the angle reference \(--angle 360\)"):
+    with pytest.raises(SegmentationError, match=r"6 no plateau.*calibrate with the angle reference \(angle 360\)"):
         calibrate(rec, speed=fast.speed)
     _within_4_sigma(calibrate(rec, angle=2 * math.pi))

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from gyrocal.errors import FileFormatError, InputError, OutOfRangeError
-from gyrocal.models import correct
+from gyrocal.files import load_thermal, save_thermal
+from gyrocal.models import correct, kg_to_kb
 from gyrocal.recording import Recording
 from gyrocal.simulation.thermal_truth import ThermalTruth
 from gyrocal.thermal import (
@@ -16,8 +17,6 @@ from gyrocal.thermal import (
     fit_smooth,
     smooth_temperature,
 )
-from gyrocal.files import load_thermal, save_thermal
-from gyrocal.models import kg_to_kb
 
 TEMPS = np.array([-40.0, -30, -20, -10, 0, 10, 20, 30, 40, 50])
 TRUTH = ThermalTruth()
@@ -161,3 +160,15 @@ def test_singular_k_is_refused():
     kg[4, :9] = 0.0
     with pytest.raises(InputError, match="0 degC is singular"):
         ThermalCalibration(temps=TEMPS, kg=kg, smooth=fit_smooth(TEMPS, TRUTH.kg(TEMPS)))
+
+
+@pytest.mark.parametrize(("fs", "tau", "n"), [(200.0, 20.0, 60_000), (1.0, 20.0, 3_000), (100.0, 0.01, 20_000)])
+def test_temperature_smoothing_equals_two_passes_of_scipy_lfilter(rng, fs, tau, n):
+    """Reference: scipy.signal.lfilter, forward then backward, each pass starting at its first reading."""
+    from scipy.signal import lfilter
+
+    x = np.round(20 + np.cumsum(rng.normal(0, 0.01, n)) + rng.normal(0, 0.3, n))  # whole-degree readings
+    a = np.exp(-1 / (fs * tau))
+    y, _ = lfilter([1 - a], [1, -a], x, zi=[a * x[0]])
+    y, _ = lfilter([1 - a], [1, -a], y[::-1], zi=[a * y[-1]])
+    np.testing.assert_allclose(smooth_temperature(x, fs, tau), y[::-1], rtol=1e-11, atol=0)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from gyrocal.errors import InputError
-from gyrocal.io import write_csv
+from gyrocal.io import read_session, write_csv
 from gyrocal.recording import Recording
 from gyrocal.simulation.thermal_truth import ThermalTruth
 from gyrocal.simulation.turntable import TurntableProtocol, simulate_turntable
@@ -15,7 +15,6 @@ from gyrocal.thermal import (
     find_steps,
     session_steps,
 )
-from gyrocal.io import read_session
 
 NOISE = np.radians(0.05)
 FAST = {"step_duration": 3.0, "rates": (0.0, 10.0, 100.0, 400.0)}

@@ -37,8 +37,8 @@ import numpy as np
 from ._jsonfile import check_header, get, get_array
 from ._validation import refuse_options
 from ._version import __version__
-from .files import register
 from .errors import FileFormatError, InputError, NonPhysicalEstimateError, UnitError
+from .files import register
 from .models import KG_NAMES, Affine, CalibrationModel, ScaleBias
 from .recording import Recording
 from .sections import AccelerometerPart, FitQuality, Observed, section

@@ -17,6 +17,7 @@ __all__ = [
     "GuideName",
     "InputUnit",
     "Method",
+    "MotionPolicy",
     "OutOfRange",
     "Protocol",
     "RateUnit",
@@ -42,7 +43,9 @@ OutOfRange = Literal["refuse", "clamp", "extrapolate"]
 #: How a thermal table is evaluated in temperature ("traditional": the paper's one-temperature baseline).
 TableModel = Literal["lagrange", "smooth", "traditional"]
 #: Motion sources of ``gyrocal simulate`` (see :mod:`gyrocal.simulation`).
-Protocol = Literal["servo", "hand", "turntable", "profile"]
+Protocol = Literal["servo", "hand", "turntable", "profile", "static"]
+#: What a noise analysis does with a log that moves: analyse its longest still stretch, or refuse it.
+MotionPolicy = Literal["restrict", "refuse"]
 #: How ``gyrocal simulate`` stamps its samples: on the sensor's clock, or as a PC receiving packets.
 TimeStamps = Literal["sensor", "receive"]
 #: Monte Carlo studies reproducing the papers (see :mod:`gyrocal.studies`).

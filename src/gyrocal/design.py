@@ -42,11 +42,11 @@ import numpy as np
 from ._arrays import readonly
 from ._validation import finite_array, positive
 from .errors import InputError
-from .estimators._checks import require_count, require_full_rank
+from .estimators import require_count, require_full_rank
 from .estimators.first_moment import PARAM_NAMES, residuals_and_jacobian, sandwich_covariance
 from .models import ScaleBias
 from .observations import ObservationSet
-from .simulation.windows import axis_vector
+from .windows import axis_vector
 
 __all__ = [
     "Design",

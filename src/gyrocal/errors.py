@@ -12,6 +12,7 @@ as ``--out-of-range`` on the command line), so no front end rewrites the text.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from typing import Any
 
@@ -32,6 +33,7 @@ __all__ = [
 ]
 
 PARAM = "{param}"
+_OTHER_PARAM = re.compile(r"\{param:([A-Za-z_]\w*)\}")
 
 
 class GyrocalError(Exception):
@@ -40,7 +42,8 @@ class GyrocalError(Exception):
     Parameters
     ----------
     message : str
-        What is wrong, in one sentence; may say ``{param}`` for the parameter's name.
+        What is wrong, in one sentence; may say ``{param}`` for the parameter's name, and
+        ``{param:skip_rows}`` for another parameter's (here ``skip_rows``).
     param : str, optional
         The Python parameter at fault (``"sample_rate"``); front ends map it to their own name.
     value : object, optional
@@ -57,11 +60,16 @@ class GyrocalError(Exception):
         self.hint = hint
 
     def render(self, name: Callable[[str], str] | None = None) -> str:
-        """The one-line text, with ``{param}`` replaced by ``name(param)`` (default: the Python name)."""
+        """The one-line text, with ``{param}`` replaced by ``name(param)`` (default: the Python name).
+
+        A message or hint that points to another parameter too names it ``{param:skip_rows}``
+        (``"... or skip the lines above it with {param:skip_rows} N"``), filled in the same way.
+        """
         text = self.message if not self.hint else f"{self.message}; {self.hint}"
+        name = name or (lambda param: param)
         if self.param is not None:
-            text = text.replace(PARAM, name(self.param) if name is not None else self.param)
-        return text
+            text = text.replace(PARAM, name(self.param))
+        return _OTHER_PARAM.sub(lambda m: name(m.group(1)), text)
 
     def __str__(self) -> str:
         return self.render()

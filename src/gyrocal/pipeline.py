@@ -2,8 +2,8 @@
 
 ``calibrate`` is what the ``gyrocal calibrate`` command runs. With a known speed the
 rotation windows are the constant-speed plateaus and their reference is the speed; with
-a known angle they are whole turns and their reference is ``angle / duration`` (SPEC,
-Method S, first-moment form). A windows file overrides detection.
+a known angle they are whole turns and their reference is ``angle / duration`` (docs/core.md,
+Estimators, first-moment form). A windows file overrides detection.
 
 Which windows each method uses:
 
@@ -26,6 +26,7 @@ from .calibration import Calibration
 from .errors import InputError
 from .estimators import FitResult, make_estimator, window_residuals
 from .observations import Observation, ObservationSet
+from .observed import quiet_noise
 from .plausibility import Context, check_plausibility
 from .quality import GoodnessOfFit, assess_fit
 from .recording import Recording
@@ -36,7 +37,7 @@ from .units import parse_input_unit, parse_rate_unit, unit_factor
 from .window_stats import observe_windows
 from .windows import Window
 
-__all__ = ["CalibrationRun", "calibrate"]
+__all__ = ["CalibrationRun", "calibrate", "parameter_rows"]
 
 
 @dataclass(frozen=True)
@@ -80,21 +81,11 @@ class CalibrationRun:
     notes: tuple[str, ...] = ()
 
     def parameters(self) -> list[tuple[str, float, float, str]]:
-        """``(name, value, 1-sigma, unit)`` of k and b in user units (sigma NaN if unknown)."""
-        cal = self.calibration
-        c, d = cal.input_scale, unit_factor(cal.output_units)
-        p = cal.model.params
-        std = cal.std if cal.std is not None else np.full(len(p), np.nan)
-        k_unit = "1" if cal.input_units == cal.output_units else f"{cal.output_units} per {cal.input_units}"
-        rows = []
-        for j, axis in enumerate("xyz"):
-            rows.append((f"k{axis}", p[j] * c / d, std[j] * c / d, k_unit))
-        for j, axis in enumerate("xyz"):
-            rows.append((f"b{axis}", p[3 + j] / c, std[3 + j] / c, cal.input_units))
-        return rows
+        """``(name, value, 1-sigma, unit)`` of k and b in user units (see :func:`parameter_rows`)."""
+        return parameter_rows(self.calibration)
 
     def scale_bias_note(self) -> str | None:
-        """For the paper's mean-of-squares methods, how low they read k (SPEC); None otherwise."""
+        """For the paper's mean-of-squares methods, how low they read k (docs/core.md, Accuracy); None otherwise."""
         fit = self.fit
         if self.calibration.method == "first-moment" or fit.noise_std is None:
             return None
@@ -189,6 +180,28 @@ def _given_windows(rec: Recording, windows: Sequence[Window], reference: str, sp
     return Segmentation(tuple(out), (), "file", fs, base, noise)
 
 
+def parameter_rows(cal: Calibration) -> list[tuple[str, float, float, str]]:
+    """``(name, value, 1-sigma, unit)`` of k and b (Wang et al., eq. 1) in user units (sigma NaN if unknown).
+
+    k and b are what the file stores (``parameters``), in the user's units: with counts and a
+    sensitivity, k is relative to that sensitivity (1 = as declared) and b is in the output unit,
+    as the counts were converted before the fit; with counts alone, k absorbs the sensitivity
+    (output unit per count) and b is in counts.
+    """
+    p = cal.model.params
+    std = cal.std if cal.std is not None else np.full(len(p), np.nan)
+    d = unit_factor(cal.output_units)
+    if cal.input_units == "counts" and cal.sensitivity is not None:
+        k_scale, b_scale, k_unit, b_unit = 1.0, 1.0 / d, "1", cal.output_units
+    else:
+        c = cal.input_scale
+        k_scale, b_scale, b_unit = c / d, 1.0 / c, cal.input_units
+        per = "count" if cal.input_units == "counts" else cal.input_units
+        k_unit = "1" if cal.input_units == cal.output_units else f"{cal.output_units} per {per}"
+    rows = [(f"k{axis}", p[j] * k_scale, std[j] * k_scale, k_unit) for j, axis in enumerate("xyz")]
+    return rows + [(f"b{axis}", p[3 + j] * b_scale, std[3 + j] * b_scale, b_unit) for j, axis in enumerate("xyz")]
+
+
 def calibrate(
     rec: Recording,
     *,
@@ -242,6 +255,8 @@ def calibrate(
     InputError
         For Algorithm 1 and LM, a rotation window whose rate varies (ramps, hand turns).
     """
+    # long function: the pipeline's steps in the order they run (references, segmentation, time base,
+    # observations, fit, checks, file sections), each already a call of its own
     if (speed is None) == (angle is None):
         raise InputError(f"give exactly one of speed [rad/s] or angle [rad], got speed={speed!r}, angle={angle!r}")
     reference = "speed" if speed is not None else "angle"
@@ -318,7 +333,9 @@ def _observed(rec: Recording, tb: TimeBase, noise_std, input_scale: float, input
     peak = np.array([max(float(c.max()), -float(c.min())) for c in sample.T])
     return {"sample_rate": rec.sample_rate, "units": input_units,
             "noise_std": (np.asarray(noise_std, dtype=float) / input_scale).tolist(),
-            "max_abs_rate": (peak / input_scale).tolist(), "time_base": tb.to_document()}
+            "max_abs_rate": (peak / input_scale).tolist(), "time_base": tb.to_document(),
+            # the noise of the quiet stretches, measured as apply measures the data it corrects
+            "quiet_noise_std": quiet_noise(rec.gyro / input_scale, rec.sample_rate).tolist()}
 
 
 def _single_turns(windows: Sequence[Window], reference: str, declared: float) -> list[str]:

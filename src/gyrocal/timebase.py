@@ -19,7 +19,6 @@ no stamp can give back.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np

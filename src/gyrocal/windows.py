@@ -6,9 +6,11 @@ import math
 from dataclasses import dataclass, fields
 from typing import Literal
 
+import numpy as np
+
 from .errors import InputError
 
-__all__ = ["Window", "WindowKind"]
+__all__ = ["Window", "WindowKind", "axis_vector"]
 
 WindowKind = Literal["rotation", "static"]
 
@@ -70,3 +72,15 @@ class Window:
         return cls(int(d["start"]), int(d["stop"]), d["kind"], d.get("axis"), int(d.get("sign") or 0),
                    math.nan if angle is None else math.radians(angle), math.nan if rate is None else float(rate),
                    str(d.get("label") or ""))
+
+
+def axis_vector(name: str) -> np.ndarray:
+    """Unit vector of a signed axis name such as ``"+x"`` or ``"-z"``."""
+    key = str(name).strip().lower()
+    if len(key) == 1:
+        key = "+" + key
+    if len(key) != 2 or key[0] not in "+-" or key[1] not in "xyz":
+        raise InputError(f"axis {name!r} is not one of +x, -x, +y, -y, +z, -z")
+    e = np.zeros(3)
+    e["xyz".index(key[1])] = 1.0 if key[0] == "+" else -1.0
+    return e

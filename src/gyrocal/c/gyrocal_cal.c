@@ -70,27 +70,35 @@ static gyrocal_status_t solve(float *a, float *b, int n, int nrhs)
     return GYROCAL_OK;
 }
 
-void gyrocal_correct(const gyrocal_affine_t *cal, const float raw[3], float out[3])
+gyrocal_status_t gyrocal_correct(const gyrocal_affine_t *cal, const float raw[3], float out[3])
 {
     float d[3];
     int i;
+    if (cal == 0 || raw == 0 || out == 0) {
+        return GYROCAL_E_INPUT;
+    }
     for (i = 0; i < 3; ++i) {
         d[i] = raw[i] - cal->offset[i];
     }
     for (i = 0; i < 3; ++i) {
         out[i] = cal->matrix[i][0] * d[0] + cal->matrix[i][1] * d[1] + cal->matrix[i][2] * d[2];
     }
+    return GYROCAL_OK;
 }
 
-void gyrocal_scale_bias_to_affine(const gyrocal_scale_bias_t *sb, gyrocal_affine_t *out)
+gyrocal_status_t gyrocal_scale_bias_to_affine(const gyrocal_scale_bias_t *sb, gyrocal_affine_t *out)
 {
     int i, j;
+    if (sb == 0 || out == 0 || !finite3(sb->k) || !finite3(sb->b)) {
+        return GYROCAL_E_INPUT;
+    }
     for (i = 0; i < 3; ++i) {
         for (j = 0; j < 3; ++j) {
             out->matrix[i][j] = (i == j) ? sb->k[i] : 0.0f;
         }
         out->offset[i] = -sb->b[i];
     }
+    return GYROCAL_OK;
 }
 
 /* Position in K (the full-temperature-range method, eq. 11) of the Kg elements 0..8 (eq. 14), as row * 3 + column. */
@@ -98,6 +106,9 @@ static const uint8_t KG_SLOT[9] = {0, 4, 8, 1, 2, 3, 5, 6, 7};
 
 float gyrocal_temp_filter(float *state, float temp, float alpha)
 {
+    if (state == 0) {
+        return temp;
+    }
     *state += alpha * (temp - *state);
     return *state;
 }
@@ -108,11 +119,18 @@ gyrocal_status_t gyrocal_thermal_correct(const gyrocal_thermal_t *table, float t
     float k[9], d[3], w[3];
     const float *t;
     int n, i, s, e;
-    if (table == 0 || table->n < 3 || !isfinite(temp) || !finite3(raw) || (flags & ~GYROCAL_THERMAL_CLAMP)) {
+    if (table == 0 || table->temps == 0 || table->kg == 0 || raw == 0 || out == 0 || table->n < 3 ||
+        !isfinite(temp) || !finite3(raw) || (flags & ~GYROCAL_THERMAL_CLAMP)) {
         return GYROCAL_E_INPUT;
     }
     n = table->n;
     t = table->temps;
+    /* a malformed table (repeated, decreasing or non-finite nodes) would divide by zero below */
+    for (i = 0; i < n; ++i) {
+        if (!isfinite(t[i]) || (i > 0 && !(t[i] > t[i - 1]))) {
+            return GYROCAL_E_INPUT;
+        }
+    }
     if (temp < t[0] || temp > t[n - 1]) {
         if (!(flags & GYROCAL_THERMAL_CLAMP) && (temp < t[0] - GYROCAL_THERMAL_MARGIN ||
                                                   temp > t[n - 1] + GYROCAL_THERMAL_MARGIN)) {
@@ -150,6 +168,9 @@ gyrocal_status_t gyrocal_thermal_correct(const gyrocal_thermal_t *table, float t
 
 void gyrocal_accum_reset(gyrocal_accum_t *acc)
 {
+    if (acc == 0) {
+        return;
+    }
     acc->count = 0u; /* the sums are cleared by the next sample, see gyrocal_accum_add */
 }
 
@@ -168,6 +189,9 @@ static void comp_add(float *sum, float *comp, float x)
 void gyrocal_accum_add(gyrocal_accum_t *acc, const float sample[3])
 {
     int i;
+    if (acc == 0 || sample == 0) {
+        return;
+    }
     if (acc->count == 0u) {
         /* Cleared here rather than in reset: a zeroing loop would compile to a call to memset. */
         for (i = 0; i < 3; ++i) {
@@ -187,8 +211,12 @@ void gyrocal_accum_add(gyrocal_accum_t *acc, const float sample[3])
 gyrocal_status_t gyrocal_accum_finish(const gyrocal_accum_t *acc, float rate, gyrocal_obs_t *obs)
 {
     float mean[3], mean_sq[3];
-    float n = (float)acc->count; /* exact up to 2^24 samples */
+    float n;
     int i;
+    if (acc == 0 || obs == 0) {
+        return GYROCAL_E_INPUT;
+    }
+    n = (float)acc->count; /* exact up to 2^24 samples */
     if (acc->count < 2u || !isfinite(rate) || rate < 0.0f) {
         return GYROCAL_E_INPUT;
     }
@@ -286,7 +314,7 @@ gyrocal_status_t gyrocal_algorithm1(const gyrocal_obs_t obs[GYROCAL_N_OBS], gyro
 {
     float u[N6], v[N6], beta[N6], r;
     int it, j;
-    gyrocal_status_t st = six_solve(obs, 0, u, v, &r);
+    gyrocal_status_t st = (obs == 0 || out == 0) ? GYROCAL_E_INPUT : six_solve(obs, 0, u, v, &r);
     if (st != GYROCAL_OK) {
         return st;
     }
@@ -324,7 +352,7 @@ gyrocal_status_t gyrocal_first_moment(const gyrocal_obs_t obs[GYROCAL_N_OBS], gy
 {
     float u[N6], v[N6], beta[N6], r, b0 = 0.0f, vsum = 0.0f;
     int it, j;
-    gyrocal_status_t st = six_solve(obs, 1, u, v, &r);
+    gyrocal_status_t st = (obs == 0 || out == 0) ? GYROCAL_E_INPUT : six_solve(obs, 1, u, v, &r);
     if (st != GYROCAL_OK) {
         return st;
     }

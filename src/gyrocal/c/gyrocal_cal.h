@@ -12,8 +12,12 @@
  * The servo method of Wang et al. (eq. 1) writes g = diag(k) (m + b): matrix = diag(k), offset = -b.
  * The full-temperature-range method (eq. 12) writes w = K w~ + B: matrix = K^-1, offset = B.
  *
- * Every function that can fail returns a gyrocal_status_t; on failure the
- * outputs are left untouched, so a caller never sees NaN parameters.
+ * Every function that can fail returns a gyrocal_status_t. On failure the outputs are left
+ * untouched, so a caller never sees NaN parameters; the one exception is the iteration count of
+ * the solvers, which is written on GYROCAL_E_NOCONV too (how far they went). A NULL pointer
+ * argument, a NaN or infinite input, or a malformed table (fewer than 3 nodes, nodes not strictly
+ * increasing or not finite) gives GYROCAL_E_INPUT. Functions without a status (the accumulator,
+ * the temperature filter) do nothing with a NULL pointer.
  */
 #ifndef GYROCAL_CAL_H
 #define GYROCAL_CAL_H
@@ -96,11 +100,12 @@ typedef struct {
     float rate;
 } gyrocal_obs_t;
 
-/* w = matrix (raw - offset). */
-void gyrocal_correct(const gyrocal_affine_t *cal, const float raw[3], float out[3]);
+/* w = matrix (raw - offset); out may be raw. NaN readings give NaN rates (checking each sample
+ * would cost more than the correction). */
+gyrocal_status_t gyrocal_correct(const gyrocal_affine_t *cal, const float raw[3], float out[3]);
 
 /* The canonical form of the servo method's parameters (Wang et al.): matrix = diag(k), offset = -b. */
-void gyrocal_scale_bias_to_affine(const gyrocal_scale_bias_t *sb, gyrocal_affine_t *out);
+gyrocal_status_t gyrocal_scale_bias_to_affine(const gyrocal_scale_bias_t *sb, gyrocal_affine_t *out);
 
 /* w = K(T)^-1 (raw - B(T)), Kg(T) by 3-node Lagrange interpolation (the full-temperature-range method, eq. 21-22) over nodes
  * s, s+1, s+2 with s = clamp(i - 2, 0, n - 3) and i the first node >= T. */
@@ -110,12 +115,14 @@ gyrocal_status_t gyrocal_thermal_correct(const gyrocal_thermal_t *table, float t
 /* One step of a first-order low-pass of the temperature reading [degC] before gyrocal_thermal_correct,
  * so that readings in whole degrees do not make the corrected output jump. alpha = 1 - expf(-dt / tau)
  * for sample interval dt and time constant tau (GYROCAL_THERMAL_TEMP_TAU_S in exported headers);
- * set *state to the first reading before the first call. Returns the filtered temperature. */
+ * set *state to the first reading before the first call. Returns the filtered temperature (temp itself
+ * when state is NULL). */
 float gyrocal_temp_filter(float *state, float temp, float alpha);
 
 void gyrocal_accum_reset(gyrocal_accum_t *acc);
 void gyrocal_accum_add(gyrocal_accum_t *acc, const float sample[3]);
-/* Window mean and mean of squares; `rate` is stored as the observation's reference. */
+/* Window mean and mean of squares; `rate` is stored as the observation's reference. A window with a
+ * NaN or infinite sample gives GYROCAL_E_INPUT here. */
 gyrocal_status_t gyrocal_accum_finish(const gyrocal_accum_t *acc, float rate, gyrocal_obs_t *obs);
 
 /* The servo method of Wang et al., Algorithm 1 on exactly six observations (regressors: means of squares and means). */

@@ -8,6 +8,9 @@ uint16_t gyrocal_crc16(const uint8_t *data, size_t n, uint16_t crc)
 {
     size_t i;
     int bit;
+    if (data == 0) {
+        return crc;
+    }
     for (i = 0; i < n; ++i) {
         crc ^= (uint16_t)((uint16_t)data[i] << 8);
         for (bit = 0; bit < 8; ++bit) {
@@ -47,7 +50,7 @@ size_t gyrocal_frame(uint8_t out[GYROCAL_FRAME_MAX], uint8_t type, const uint8_t
 {
     size_t i;
     uint16_t crc;
-    if (len > GYROCAL_FRAME_MAX_PAYLOAD) {
+    if (out == 0 || len > GYROCAL_FRAME_MAX_PAYLOAD || (payload == 0 && len > 0u)) {
         return 0u;
     }
     out[0] = GYROCAL_FRAME_SYNC0;
@@ -66,8 +69,12 @@ size_t gyrocal_frame(uint8_t out[GYROCAL_FRAME_MAX], uint8_t type, const uint8_t
 
 size_t gyrocal_frame_hello(uint8_t out[GYROCAL_FRAME_MAX], const gyrocal_hello_t *hello)
 {
-    uint8_t *p = out + 4;
+    uint8_t *p;
     int i;
+    if (out == 0 || hello == 0) {
+        return 0u;
+    }
+    p = out + 4;
     *p++ = GYROCAL_FRAME_PROTOCOL;
     *p++ = hello->flags;
     *p++ = hello->rate_unit;
@@ -85,9 +92,12 @@ size_t gyrocal_frame_hello(uint8_t out[GYROCAL_FRAME_MAX], const gyrocal_hello_t
 size_t gyrocal_frame_sample(uint8_t out[GYROCAL_FRAME_MAX], uint32_t seq, uint32_t t_us, const int16_t raw[3],
                             int16_t temp_centi)
 {
-    uint8_t *p = out + 4;
+    uint8_t *p;
     int i;
-    p = put_u32(p, seq);
+    if (out == 0 || raw == 0) {
+        return 0u;
+    }
+    p = put_u32(out + 4, seq);
     p = put_u32(p, t_us);
     for (i = 0; i < 3; ++i) {
         p = put_u16(p, (uint16_t)raw[i]);
@@ -98,9 +108,12 @@ size_t gyrocal_frame_sample(uint8_t out[GYROCAL_FRAME_MAX], uint32_t seq, uint32
 
 size_t gyrocal_frame_calibrated(uint8_t out[GYROCAL_FRAME_MAX], uint32_t seq, uint32_t t_us, const float w[3])
 {
-    uint8_t *p = out + 4;
+    uint8_t *p;
     int i;
-    p = put_u32(p, seq);
+    if (out == 0 || w == 0) {
+        return 0u;
+    }
+    p = put_u32(out + 4, seq);
     p = put_u32(p, t_us);
     for (i = 0; i < 3; ++i) {
         p = put_f32(p, w[i]);
@@ -110,9 +123,12 @@ size_t gyrocal_frame_calibrated(uint8_t out[GYROCAL_FRAME_MAX], uint32_t seq, ui
 
 size_t gyrocal_frame_turn(uint8_t out[GYROCAL_FRAME_MAX], const gyrocal_turn_t *turn)
 {
-    uint8_t *p = out + 4;
+    uint8_t *p;
     int i;
-    p = put_u32(p, turn->start);
+    if (out == 0 || turn == 0) {
+        return 0u;
+    }
+    p = put_u32(out + 4, turn->start);
     p = put_u32(p, turn->stop);
     p = put_f32(p, turn->rate);
     p = put_f32(p, turn->angle);
@@ -128,8 +144,12 @@ size_t gyrocal_frame_turn(uint8_t out[GYROCAL_FRAME_MAX], const gyrocal_turn_t *
 size_t gyrocal_frame_result(uint8_t out[GYROCAL_FRAME_MAX], gyrocal_status_t status, uint8_t method,
                             uint8_t iterations, uint8_t n_turns, const gyrocal_scale_bias_t *sb, uint32_t seq)
 {
-    uint8_t *p = out + 4;
+    uint8_t *p;
     int i;
+    if (out == 0) {
+        return 0u;
+    }
+    p = out + 4;
     *p++ = (uint8_t)status;
     *p++ = method;
     *p++ = iterations;
@@ -147,6 +167,9 @@ size_t gyrocal_frame_result(uint8_t out[GYROCAL_FRAME_MAX], gyrocal_status_t sta
 size_t gyrocal_frame_text(uint8_t out[GYROCAL_FRAME_MAX], const char *text)
 {
     size_t n = 0u;
+    if (out == 0 || text == 0) {
+        return 0u;
+    }
     while (n < GYROCAL_FRAME_MAX_PAYLOAD && text[n] != '\0') {
         out[4 + n] = (uint8_t)text[n];
         ++n;

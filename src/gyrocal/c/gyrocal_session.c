@@ -9,7 +9,7 @@ enum { SETTLING = 0, STILL = 1, TURNING = 2 };
 
 gyrocal_status_t gyrocal_session_init(gyrocal_session_t *s, float sample_rate, float sensitivity, float turn_angle)
 {
-    if (!(sample_rate > 0.0f && sensitivity > 0.0f && turn_angle > 0.0f && isfinite(sample_rate) &&
+    if (s == 0 || !(sample_rate > 0.0f && sensitivity > 0.0f && turn_angle > 0.0f && isfinite(sample_rate) &&
           isfinite(sensitivity) && isfinite(turn_angle))) {
         return GYROCAL_E_INPUT;
     }
@@ -126,6 +126,9 @@ unsigned gyrocal_session_add(gyrocal_session_t *s, const int16_t raw[3])
     float d[3], x[3];
     unsigned events = 0u;
     int i;
+    if (s == 0 || raw == 0) {
+        return 0u;
+    }
     if (s->phase == SETTLING) {
         for (i = 0; i < 3; ++i) {
             x[i] = (float)raw[i];

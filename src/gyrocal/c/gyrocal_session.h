@@ -70,7 +70,7 @@ typedef struct {
 /* sample_rate [Hz], sensitivity [counts per deg/s], turn_angle [deg] (360 for the paper's turns). */
 gyrocal_status_t gyrocal_session_init(gyrocal_session_t *s, float sample_rate, float sensitivity, float turn_angle);
 
-/* One raw sample [counts]; returns GYROCAL_SESSION_* event flags (0 for most samples). */
+/* One raw sample [counts]; returns GYROCAL_SESSION_* event flags (0 for most samples, and for NULL pointers). */
 unsigned gyrocal_session_add(gyrocal_session_t *s, const int16_t raw[3]);
 
 #ifdef __cplusplus

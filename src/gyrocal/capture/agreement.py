@@ -92,11 +92,11 @@ class Agreement:
         return self.params_ratio <= 1.0 and self.means_ratio <= 1.0
 
     def report(self, unit: str = "deg/s") -> str:
-        lines = [f"{'':<4}{'device':>16}{'host, same turns':>18}",]
+        lines = [f"{'':<4}{'device':>16} {'host, same turns':>17}"]
         for j, a in enumerate("xyz"):
-            lines.append(f"k{a:<3}{self.device_k[j]:>16.8g}{self.host_k[j]:>18.8g}  [{unit} per count]")
+            lines.append(f"k{a:<3}{self.device_k[j]:>16.8g} {self.host_k[j]:>17.8g}  [{unit} per count]")
         for j, a in enumerate("xyz"):
-            lines.append(f"b{a:<3}{self.device_b[j]:>16.8g}{self.host_b[j]:>18.8g}  [counts]")
+            lines.append(f"b{a:<3}{self.device_b[j]:>16.8g} {self.host_b[j]:>17.8g}  [counts]")
         verdict = "agree" if self.agrees else "DISAGREE"
         lines.append(f"device and host {verdict} to float32 precision: worst difference {self.params_ratio:.2g} of its "
                      f"bound in k, b; {self.means_ratio:.2g} in the turn means"

@@ -74,8 +74,8 @@ _SIGNATURES = {
     "gyrocal_frame_text": (ctypes.c_size_t, [_U8P, ctypes.c_char_p]),
     "gyrocal_session_init": (ctypes.c_int, [_P(_Session), ctypes.c_float, ctypes.c_float, ctypes.c_float]),
     "gyrocal_session_add": (ctypes.c_uint, [_P(_Session), _P(ctypes.c_int16)]),
-    "gyrocal_scale_bias_to_affine": (None, [_P(_ScaleBias), ctypes.c_void_p]),
-    "gyrocal_correct": (None, [ctypes.c_void_p, _P(ctypes.c_float), _P(ctypes.c_float)]),
+    "gyrocal_scale_bias_to_affine": (ctypes.c_int, [_P(_ScaleBias), ctypes.c_void_p]),
+    "gyrocal_correct": (ctypes.c_int, [ctypes.c_void_p, _P(ctypes.c_float), _P(ctypes.c_float)]),
 }
 
 

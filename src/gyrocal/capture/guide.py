@@ -157,11 +157,13 @@ class Guide:
     def _shift(self, w: Window) -> Window:
         return dataclasses.replace(w, start=w.start + self.since, stop=w.stop + self.since)
 
-    def _accept(self, w: Window, text: str) -> list[GuideEvent]:
+    def _accept(self, w: Window, text: str, n: int) -> list[GuideEvent]:
         self._accepted.append(self._shift(w))
         events = [GuideEvent("accepted", self.index, text)]
         self.index += 1
-        self.since = self._accepted[-1].stop if w.kind == "rotation" else self.since
+        # after a turn, the next step starts where it was judged: the motion is over (with a speed reference
+        # the window is only the plateau, and the ramp down must not count as a new motion)
+        self.since = n if w.kind == "rotation" else self.since
         if self.complete:
             events.append(GuideEvent("complete", self.index - 1, "every step accepted: calibrating"))
         else:
@@ -174,7 +176,7 @@ class Guide:
         for w in seg.statics:
             if w.start >= last_motion and len(w) >= need:
                 return self._accept(Window(w.start, int(w.start + need), "static", label="static"),
-                                    f"still for {need / fs:g} s: accepted")
+                                    f"still for {need / fs:g} s: accepted", n)
         return []
 
     def _judge_turn(self, seg, n, fs, motions) -> list[GuideEvent]:
@@ -183,7 +185,7 @@ class Guide:
         want = self.steps[self.index].label
         for w in seg.rotations:
             if w.label == want:
-                return self._accept(w, f"{want}: accepted ({math.degrees(w.angle):.0f} deg in {len(w) / fs:.1f} s)")
+                return self._accept(w, f"{want}: accepted ({math.degrees(w.angle):.0f} deg in {len(w) / fs:.1f} s)", n)
         why = [r for w, r in seg.ignored if w.kind == "rotation"]
         other = [w.label for w in seg.rotations]
         if other:

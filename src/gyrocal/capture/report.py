@@ -105,9 +105,9 @@ def host_versus_device(run: CalibrationRun, agreement: Agreement, sensitivity: f
     sd = np.sqrt(np.diag(cal.covariance)) if cal.covariance is not None else np.full(6, np.nan)
     lines = [("device against the host's own calibration of the same recording (servo method of Wang et al., "
              "first-moment estimator; b in deg/s):"),
-             f"{'':<4}{'device':>12}{'host':>12}{'1-sigma':>10}{'diff/sigma':>12}"]
+             f"{'':<4}{'device':>13}{'host':>13}{'1-sigma':>10}{'diff/sigma':>12}"]
     scale = np.r_[np.ones(3), np.full(3, 180 / math.pi)]
     for i, (name, dev) in enumerate(zip(["kx", "ky", "kz", "bx", "by", "bz"], np.r_[k_dev, b_dev])):
         z = (dev - p[i]) / sd[i] if sd[i] > 0 else math.nan
-        lines.append(f"{name:<4}{dev * scale[i]:>12.6g}{p[i] * scale[i]:>12.6g}{sd[i] * scale[i]:>10.2g}{z:>12.2f}")
+        lines.append(f"{name:<4} {dev * scale[i]:>12.6g} {p[i] * scale[i]:>12.6g} {sd[i] * scale[i]:>9.2g} {z:>11.2f}")
     return lines

@@ -14,6 +14,7 @@ FLAGS: dict[str, str] = {
     # reading
     "units": "--units",
     "columns": "--columns",
+    "skip_rows": "--skip-rows",
     "sample_rate": "--sample-rate",
     "sensitivity": "--sensitivity",
     "output_units": "--output-units",
@@ -57,6 +58,21 @@ FLAGS: dict[str, str] = {
     "quantum": "--quantum",
     "bias_instability": "--bias-instability",
     "rate_random_walk": "--rrw",
+    # noise, thermal-bias, flight and VIO exports
+    "imu": "--imu",
+    "motion": "--motion",
+    "min_span": "--min-span",
+    "inflate": "--inflate",
+    "rostopic": "--rostopic",
+    "update_rate": "--update-rate",
+    "accel_noise_density": "--accel-noise-density",
+    "accel_random_walk": "--accel-random-walk",
+    "gyro_random_walk": "--gyro-random-walk",
+    "use_bound": "--random-walk-bound",
+    "slot": "--slot",
+    "device_id": "--device-id",
+    "caltemp": "--caltemp",
+    "name": "--name",
     # capture, simulate --device
     "port": "--port",
     "baud": "--baud",
@@ -66,13 +82,31 @@ FLAGS: dict[str, str] = {
     "guide": "--guide",
     "faults": "--faults",
     "pace": "--pace",
+    # simulate --reference (a reference gyro's log) and verify, whose reading flags for the reference
+    # carry the prefix ref_ (see cli/_reading.py: prefixed_params)
+    "reference": "--reference",
+    "time_offset_s": "--ref-offset",
+    "clock_drift_ppm": "--ref-drift",
+    "mounting_deg": "--ref-mounting",
+    "ref_noise_std": "--ref-noise",
+    "ref_units": "--ref-units",
+    "ref_columns": "--ref-columns",
+    "ref_skip_rows": "--ref-skip-rows",
+    "ref_sample_rate": "--ref-sample-rate",
+    "ref_sensitivity": "--ref-sensitivity",
+    "ref_topic": "--ref-topic",
+    "ref_saturation": "--ref-saturation",
+    "ref_check_units": "--ref-no-unit-check",
+    "fit_drift": "--no-drift",
+    "stretch": "--stretch",
+    "tolerance": "--tolerance",
 }
 
 #: Parameters that library errors name but that no flag sets (the command line fills them itself).
 NOT_FLAGS: frozenset[str] = frozenset({
     "accel_source_units", "covariance", "correction", "accelerometer", "fit", "observed",
     "chi2", "dof", "p_value", "birge_ratio", "covariance_scaled", "residuals", "warnings", "noise_std_axes",
-    "max_abs_rate",
+    "max_abs_rate", "mounting_rotation",
 })
 
 

@@ -53,14 +53,15 @@ def triple(name: str, text: str | None, default) -> list[float]:
 
 NoiseDensity = Annotated[Optional[str], typer.Option(
     "--noise-density",
-    help="White-noise density: rad/s/sqrt(Hz), 'N deg/s/rtHz', or a noise JSON from 'gyrocal noise --json'.")]
+    help="White-noise density: rad/s/sqrt(Hz), 'N deg/s/rtHz', or a noise JSON from 'gyrocal noise --json' "
+         "(default: none; --noise, or the study's own levels, apply).")]
 
 
 def noise_std(noise: float | None, density: str | None, sample_rate: float, default: float):
     """Per-sample white noise (3,) [rad/s] from --noise or --noise-density."""
     import numpy as np
 
-    from ..noise import noise_density_arg
+    from ..noise_file import noise_density_arg
 
     if noise is not None and density is not None:
         raise InputError("give --noise or --noise-density, not both")

@@ -87,3 +87,26 @@ def same_document(doc: dict) -> Callable[[Path], bool]:
 def json_format(fmt: str) -> Callable[[Path], bool]:
     """A `replaceable` test: the file is a JSON object of gyrocal format `fmt` (an earlier output)."""
     return lambda path: (doc := _json_object(path)) is not None and doc.get("format") == fmt
+
+
+def gyrocal_format(path: Path) -> str | None:
+    """The ``format`` of a gyrocal JSON file (``"gyrocal.calibration"``, ...), or None for anything else.
+
+    Reads the whole file only when it starts like a JSON object, so a large recording costs nothing.
+    """
+    try:
+        with open(path, "rb") as f:
+            if not f.read(64).lstrip().startswith(b"{"):
+                return None
+    except OSError:
+        return None
+    fmt = (_json_object(path) or {}).get("format")
+    return fmt if isinstance(fmt, str) and fmt.startswith("gyrocal.") else None
+
+
+def refuse_swapped(first: Path, second: Path, *, command: str, usage: str) -> None:
+    """Refuse two arguments given the wrong way round: `first` should be the gyrocal file."""
+    if first.is_file() and second.is_file() and gyrocal_format(first) is None and gyrocal_format(second) is not None:
+        raise InputError(f"{first.name} is not a gyrocal file but {second.name} is ({gyrocal_format(second)}): "
+                         f"the arguments look swapped; the {usage} first",
+                         hint=f"gyrocal {command} {second} {first} ...")

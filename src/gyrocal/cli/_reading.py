@@ -8,15 +8,16 @@ makes a second set with a prefix (``ReadingFlags("ref-")`` gives ``--ref-units``
 
 from __future__ import annotations
 
+import contextlib
 from pathlib import Path
 from typing import Annotated, Optional
 
 import typer
 
 from ..choices import SaturationPolicy
-from ..errors import InputError
+from ..errors import GyrocalError, InputError
 
-__all__ = ["READING", "ReadingFlags", "read_from_flags", "required_units"]
+__all__ = ["READING", "ReadingFlags", "prefixed_params", "read_from_flags", "required_units"]
 
 STANDARD_GRAVITY = 9.80665  # m/s^2; the library's default (gyrocal.io._build.STANDARD_GRAVITY)
 
@@ -25,28 +26,46 @@ class ReadingFlags:
     """The ``Annotated`` types of the reading flags, for one flag prefix (``""`` or ``"ref-"``)."""
 
     def __init__(self, prefix: str = ""):
-        def opt(name: str, help: str):
-            return typer.Option(f"--{prefix}{name}", help=help)
+        def opt(name: str, help: str, **kw):
+            return typer.Option(f"--{prefix}{name}", help=help, **kw)
 
-        self.Units = Annotated[Optional[str], opt("units", "Unit of the gyro columns: rad/s, deg/s or counts.")]
+        units = "<rad/s|deg/s|counts>"
+        self.Units = Annotated[Optional[str], opt(
+            "units", "Unit of the gyro columns as written in the file (required).", metavar=units)]
+        #: apply: the calibration knows its unit
+        self.UnitsOfCalibration = Annotated[Optional[str], opt(
+            "units", "Unit of the gyro columns as written in the file (default: the calibration's input unit; "
+            "deg/s and rad/s are converted).", metavar=units)]
         self.Columns = Annotated[Optional[str], opt(
-            "columns", "Map gyrocal names to the file's, e.g. gx=gyroX,gy=gyroY,gz=gyroZ[,t=time,temp=T,ax=accX].")]
+            "columns", "Map gyrocal names to the file's columns, by name or by number from 1, e.g. "
+            "gx=gyroX,gy=gyroY,gz=gyroZ[,t=time,temp=T,ax=accX] (default: found by name or a usual alias).")]
+        self.SkipRows = Annotated[Optional[int], opt(
+            "skip-rows", "Text tables: lines to skip above the header (default: metadata lines such as 'Fs,100' "
+            "are found and skipped).")]
         self.SampleRate = Annotated[Optional[float], opt(
-            "sample-rate", "Nominal sample rate [Hz]; needed when the file has no time column.")]
+            "sample-rate", "Nominal sample rate [Hz]; needed when the file has no time column (default: from the "
+            "time column, which wins when both are there).")]
         self.Sensitivity = Annotated[Optional[float], opt(
-            "sensitivity", "For --units counts: LSB per --output-units rate unit.")]
+            "sensitivity", "For --units counts: LSB per --output-units rate unit (default: none; the scale "
+            "factors absorb it).")]
         self.OutputUnits = Annotated[Optional[str], opt(
-            "output-units", "Unit of corrected rates, rad/s or deg/s (default: the data's; deg/s for counts).")]
-        self.Topic = Annotated[Optional[str], opt("topic", "sensor_msgs/Imu topic in a ROS 1/ROS 2/MCAP bag.")]
+            "output-units", "Unit of corrected rates, rad/s or deg/s (default: the data's; deg/s for counts).",
+            metavar="<rad/s|deg/s>")]
+        self.Topic = Annotated[Optional[str], opt(
+            "topic", "sensor_msgs/Imu topic in a ROS 1/ROS 2/MCAP bag (default: the only one).")]
         self.Saturation = Annotated[SaturationPolicy, opt(
             "saturation", "Samples stuck at full scale: refuse (error), drop them, or ignore.")]
         self.NoUnitCheck = Annotated[bool, opt(
             "no-unit-check", "Accept rates that look like another unit (e.g. 4000 'rad/s').")]
         self.AccelUnits = Annotated[Optional[str], opt(
-            "accel-units", "Unit of the accelerometer columns (ax, ay, az or acc_x, ...): m/s^2, g or counts.")]
+            "accel-units", "Unit of the accelerometer columns (ax, ay, az or acc_x, ...): m/s^2, g or counts "
+            "(default: none; those columns pass through as they are).", metavar="<m/s^2|g|counts>")]
         self.AccelSensitivity = Annotated[Optional[float], opt(
-            "accel-sensitivity", "For --accel-units counts: LSB per g.")]
+            "accel-sensitivity", "For --accel-units counts: LSB per g (default: none; counts stay counts).")]
         self.Gravity = Annotated[float, opt("gravity", "One g [m/s^2], for --accel-units g or counts.")]
+        self.Imu = Annotated[Optional[int], opt(
+            "imu", "PX4 ULog / ArduPilot DataFlash log: which IMU instance, from 0 (default: the only one; required "
+                   "when the log holds several).")]
 
 
 #: The reading flags without a prefix.
@@ -67,6 +86,7 @@ def read_from_flags(
     *,
     units: str,
     columns: str | None = None,
+    skip_rows: int | None = None,
     sample_rate: float | None = None,
     sensitivity: float | None = None,
     output_units: str | None = None,
@@ -77,11 +97,27 @@ def read_from_flags(
     accel_sensitivity: float | None = None,
     gravity: float = STANDARD_GRAVITY,
     need_accel: bool = False,
+    imu: int | None = None,
 ):
     """A :class:`~gyrocal.recording.Recording` from the reading flags (see :func:`gyrocal.io.read_recording`)."""
     from ..io import read_recording
 
-    return read_recording(path, units=units, columns=columns, sample_rate=sample_rate, sensitivity=sensitivity,
+    return read_recording(path, units=units, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
+                          sensitivity=sensitivity,
                           output_units=output_units, topic=topic, check_units=not no_unit_check,
                           saturation=saturation, accel_units=accel_units, accel_sensitivity=accel_sensitivity,
-                          gravity=gravity, need_accel=need_accel)
+                          gravity=gravity, need_accel=need_accel, imu=imu)
+
+
+@contextlib.contextmanager
+def prefixed_params(prefix: str):
+    """Errors raised inside the block name the prefixed flags: reading a reference log with
+    ``prefixed_params("ref_")``, a bad ``units`` shows as ``--ref-units`` (when that flag exists)."""
+    from ._flags import FLAGS
+
+    try:
+        yield
+    except GyrocalError as exc:
+        if exc.param is not None and f"{prefix}{exc.param}" in FLAGS:
+            exc.param = f"{prefix}{exc.param}"
+        raise

@@ -28,12 +28,22 @@ HELP_ORDER: list[str] = []
 
 
 class _OrderedGroup(TyperGroup):
-    """Lists commands in :data:`HELP_ORDER`, then any others by name."""
+    """Lists commands in :data:`HELP_ORDER`, then any others by name, each with its whole first sentence."""
 
     def list_commands(self, ctx):
         names = super().list_commands(ctx)
         rank = {name: i for i, name in enumerate(HELP_ORDER)}
         return sorted(names, key=lambda n: (rank.get(n, len(rank)), n))
+
+    def format_commands(self, ctx, formatter) -> None:
+        # click cuts each description to the width left by the names ("...;..."): a newcomer reads
+        # them to choose a command, so they wrap instead
+        rows = [(name, cmd.short_help or " ".join((cmd.help or "").split("\n\n")[0].split()))
+                for name in self.list_commands(ctx)
+                if (cmd := self.get_command(ctx, name)) is not None and not cmd.hidden]
+        if rows:
+            with formatter.section("Commands"):
+                formatter.write_dl(rows)
 
 
 app = typer.Typer(
@@ -44,15 +54,27 @@ app = typer.Typer(
     add_completion=False,
     pretty_exceptions_enable=False,
     rich_markup_mode=None,  # help texts carry units in brackets, e.g. [deg/s]: not markup
-    context_settings={"max_content_width": 100},
+    context_settings={"max_content_width": 100, "help_option_names": ["-h", "--help"]},
 )
 console = Console()
 err_console = Console(stderr=True)
 _state = {"debug": False}
 
 
+def _print_version(value: bool) -> None:
+    if value:
+        from .._version import __version__
+
+        console.print(f"gyrocal {__version__}", highlight=False)
+        raise typer.Exit(0)
+
+
 @app.callback()
-def _root(debug: bool = typer.Option(False, "--debug", help="Show tracebacks instead of one-line errors.")) -> None:
+def _root(
+    debug: bool = typer.Option(False, "--debug", help="Show tracebacks instead of one-line errors."),
+    version: bool = typer.Option(False, "--version", is_eager=True, callback=_print_version,
+                                 help="Print gyrocal's version and exit."),
+) -> None:
     _state["debug"] = debug
 
 
@@ -83,8 +105,13 @@ def _is_usage_error(exc: BaseException) -> bool:
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
-    """A library warning as one ``warning:`` line."""
-    warn(str(message))
+    """A library warning as one ``warning:`` line. A numerical library's own warnings (numpy's
+    RuntimeWarning, ...) say nothing a user can act on: they show with ``--debug`` only; the test
+    suite turns every one of them into an error, so each is found and fixed at its source."""
+    if issubclass(category, GyrocalWarning):
+        warn(str(message))
+    elif _state["debug"]:
+        warn(f"{category.__name__}: {message} ({filename}:{lineno})")
 
 
 def message(exc: BaseException) -> str:
@@ -96,11 +123,13 @@ def message(exc: BaseException) -> str:
 
 def run(argv: list[str] | None = None) -> int:
     """Run the CLI; map library, OS and usage errors to one line and exit code 2."""
+    if argv is not None and not argv:
+        argv = ["--help"]  # bare 'gyrocal' is a request for help, not a mistake
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("always", GyrocalWarning)
             warnings.showwarning = _show_warning
-            rv = app(args=argv, standalone_mode=False)
+            rv = app(args=argv, prog_name="gyrocal", standalone_mode=False)
     except (GyrocalError, OSError) as exc:
         if _state["debug"]:
             raise
@@ -111,10 +140,41 @@ def run(argv: list[str] | None = None) -> int:
     except typer.Abort:
         err_console.print("aborted")
         return 1
+    except KeyboardInterrupt:
+        if _state["debug"]:
+            raise
+        err_console.print("interrupted; no output was left half written")
+        return 130
     except Exception as exc:
         if not _is_usage_error(exc) or _state["debug"]:
             raise
-        fail(f"{exc.format_message()} (see 'gyrocal --help')")
+        fail(usage_line(exc))
         return 2
     # Without standalone mode, typer returns the code of a raised Exit instead of raising it.
     return rv if isinstance(rv, int) else 0
+
+
+def usage_line(exc) -> str:
+    """One line for a command-line mistake (a missing option, a bad choice, a number that is not one),
+    pointing to the help of the command it was typed for."""
+    ctx = getattr(exc, "ctx", None)
+    where = ctx.command_path if ctx is not None else "gyrocal"
+    param = getattr(exc, "param", None)
+    cause = exc.__cause__
+    errors = cause.errors() if cause is not None and hasattr(cause, "errors") else None
+    if param is not None and errors:
+        opts = getattr(param, "opts", None) or [param.name]
+        name = max(opts, key=len) if getattr(param, "param_type_name", "") == "option" else str(param.name).upper()
+        first = errors[0]
+        value, kind = first.get("input"), str(first.get("type", ""))
+        if kind == "value_error":
+            text = str(first.get("msg", "")).removeprefix("Value error, ").rstrip(".")
+        elif kind.startswith(("int_", "float_")) or "parsing" in kind:
+            text = f"{value!r} is not {'a whole number' if kind.startswith('int') else 'a number'}"
+        else:
+            text = f"{value!r}: {first.get('msg', '')}"
+        line = f"invalid value for {name}: {text}"
+    else:
+        line = exc.format_message().rstrip(".")
+        line = line[:1].lower() + line[1:]
+    return f"{line} (see '{where} --help')"

@@ -10,9 +10,9 @@ import typer
 from ..choices import OutOfRange, TableModel
 from ..errors import InputError
 from ._options import given
-from ._outputs import check_output, starts_with
+from ._outputs import check_output, refuse_swapped, starts_with
 from ._reading import READING, read_from_flags
-from .app import app, console
+from .app import app, console, warn
 
 __all__ = ["apply"]
 
@@ -27,8 +27,9 @@ def apply(
     calibration: Annotated[Path, typer.Argument(help="A gyrocal calibration or thermal calibration file.")],
     recording: Annotated[Path, typer.Argument(help="Recording to correct.")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Corrected CSV.")],
-    units: READING.Units = None,
+    units: READING.UnitsOfCalibration = None,
     columns: READING.Columns = None,
+    skip_rows: READING.SkipRows = None,
     sample_rate: READING.SampleRate = None,
     topic: READING.Topic = None,
     saturation: READING.Saturation = "error",
@@ -40,23 +41,34 @@ def apply(
     = "lagrange",
     out_of_range: Annotated[OutOfRange, typer.Option(
         "--out-of-range", help="Thermal files: temperatures outside the calibrated range.")] = "refuse",
-    force: Annotated[bool, typer.Option("--force", help="Replace an existing output that gyrocal did not write.")]
-    = False,
+    force: Annotated[bool, typer.Option(
+        "--force", help="Replace an existing output that gyrocal did not write, and correct data that "
+        "'gyrocal apply' already corrected.")] = False,
 ) -> None:
     """Correct a recording; gyro columns are replaced by corrected rates, other columns pass through."""
     from ..files import load
-    from ..io import write_recording
-    from ..units import parse_input_unit
+    from ..io import read_header_comment, write_recording
 
+    refuse_swapped(calibration, recording, command="apply", usage="calibration file comes")
     check_output(output, inputs=(calibration, recording), force=force, replaceable=starts_with(f"# {_APPLIED}"))
     cal = load(calibration)
-    expected = cal.input_units
-    if units is not None and parse_input_unit(units, "units") != expected:
-        raise InputError(f"--units {units} does not match the calibration's input units {expected}; "
-                         f"{calibration} applies to data in {expected}")
-    rec = read_from_flags(recording, units=expected, columns=columns, sample_rate=sample_rate, topic=topic,
-                          saturation=saturation, no_unit_check=no_unit_check, accel_units=accel_units,
+    comment = read_header_comment(recording)
+    if not force and comment is not None and comment.startswith(_APPLIED):
+        raise InputError(f"{recording.name} was written by 'gyrocal apply' ('# {comment[:60]}'): its rates are "
+                         f"corrected already, and {calibration.name} would correct them twice",
+                         hint="give the raw recording, or --force to correct it again")
+    unit = _unit(units, cal, calibration)
+    rec = read_from_flags(recording, units=unit, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
+                          topic=topic, saturation=saturation, no_unit_check=no_unit_check, accel_units=accel_units,
                           accel_sensitivity=accel_sensitivity, gravity=gravity)
+    if not no_unit_check and getattr(cal, "observed", None) is not None:
+        from ..observed import check_observed
+
+        raw = rec.gyro / cal.input_scale if rec.units == "rad/s" else rec.gyro
+        note = check_observed(cal.observed, raw, rec.sample_rate, source=recording.name, calibration=calibration.name,
+                              sensitivity=cal.sensitivity, output_units=cal.output_units)
+        if note is not None:
+            warn(note)
     options = {name: value for name, value in (("model", model), ("out_of_range", out_of_range))
                if given(ctx, name)}
     corrected = cal.apply(rec, **options)
@@ -65,3 +77,19 @@ def apply(
     note = f"{_APPLIED} with {Path(calibration).name}; gx gy gz in {out_units}{accel}"
     write_recording(output, corrected, header_comment=note)
     console.print(f"wrote {output} ({len(corrected)} rows, gx gy gz in {out_units})", highlight=False)
+
+
+def _unit(units: str | None, cal, calibration: Path) -> str:
+    """The unit to read the data in: the calibration's by default. Another rate unit is converted
+    (rates are physical), and so are rates for a counts calibration that knows its sensitivity."""
+    from ..units import parse_input_unit
+
+    expected = cal.input_units
+    if units is None:
+        return expected
+    unit = parse_input_unit(units, "units")
+    convertible = "counts" not in (unit, expected) or (expected == "counts" and cal.sensitivity is not None)
+    if unit != expected and not convertible:
+        raise InputError(f"{{param}} {units} does not match the calibration's input units {expected}", param="units",
+                         value=units, hint=f"{calibration.name} corrects data in {expected}")
+    return unit

@@ -30,13 +30,17 @@ EXAMPLE_SPEED = 60.0  # deg/s, the servo protocol of Wang et al.
 
 
 WindowsFile = Annotated[Optional[Path], typer.Option(
-    "--windows", help="Windows file (JSON/CSV list, or imucal's section list) that replaces detection.")]
+    "--windows", help="Windows file (JSON/CSV list, or imucal's section list) that replaces detection "
+    "(default: detected).")]
 Speed = Annotated[Optional[float], typer.Option(
-    "--speed", help="Known constant turn rate, in the data's rate unit (deg/s with --units deg/s).")]
+    "--speed", help="Known constant turn rate, in the data's rate unit (deg/s with --units deg/s; --output-units "
+    "for counts) (default: none, --angle 360).")]
 Angle = Annotated[Optional[float], typer.Option(
-    "--angle", help="Known angle of each turn, in degrees (e.g. 360); the speed may vary.")]
-PlotPath = Annotated[Optional[Path], typer.Option("--plot", help="Write a picture (.png, .pdf or .svg).")]
-Output = Annotated[Optional[Path], typer.Option("-o", "--output", help="Output file.")]
+    "--angle", help="Known angle of each turn, in degrees; the speed may vary (default: 360 unless --speed).")]
+PlotPath = Annotated[Optional[Path], typer.Option(
+    "--plot", help="Write a picture (.png, .pdf or .svg) (default: none).")]
+Output = Annotated[Optional[Path], typer.Option(
+    "-o", "--output", help="Calibration file to write (default: none; the parameters are printed).")]
 Force = Annotated[bool, typer.Option("--force", help="Replace an output that holds a different calibration.")]
 
 
@@ -78,7 +82,7 @@ def _noise_to_internal(noise_std: float | None, units: str, rate_unit: str, sens
 
 def _density_to_internal(noise_density: str, noise_std: float | None, rec):
     """--noise-density (rad/s/sqrt(Hz), per axis) as per-sample noise [rad/s] at the recording's rate."""
-    from ..noise import noise_density_arg
+    from ..noise_file import noise_density_arg
 
     if noise_std is not None:
         raise InputError("give --noise-std or --noise-density, not both")
@@ -112,25 +116,28 @@ def _example_paths() -> tuple[Path, Path]:
 def _params_table(run, truth=None):
     """Rich tables: k, b (the servo method of Wang et al.) in user units with 1-sigma (and the truth,
     for the example), and the canonical correction."""
-    import numpy as np
     from rich.markup import escape
     from rich.table import Table
 
     cal = run.calibration
+    matrix, offset = cal.correction
     table = Table()
-    for col in ("parameter", "estimate", "1-sigma") + (("truth", "error / sigma") if truth is not None else ()):
-        table.add_column(col, justify="left" if col == "parameter" else "right")
+    # b is added to the reading (Wang et al., eq. 1): the offset beside it is what the gyro reads at rest
+    for col in ("parameter", "estimate", "1-sigma", f"at rest\n[{cal.input_units}]") + (
+            ("truth", "error\n/ sigma") if truth is not None else ()):
+        table.add_column(escape(col), justify="left" if col == "parameter" else "right", no_wrap=True)
     true_values = None
     if truth is not None:
-        matrix, offset = truth.correction
-        true_values = list(np.diag(matrix)) + list(-offset)  # k, and b = -offset (Wang et al., eq. 1)
+        from ..pipeline import parameter_rows
+
+        true_values = [value for _, value, _, _ in parameter_rows(truth)]
     for i, (name, value, sigma, unit) in enumerate(run.parameters()):
-        row = [escape(f"{name} [{unit}]"), f"{value:.6g}", "n/a" if math.isnan(sigma) else f"{sigma:.2g}"]
+        rest = f"{offset[i - 3]:+.6g}" if i >= 3 else ""
+        row = [escape(f"{name} [{unit}]"), f"{value:.6g}", "n/a" if math.isnan(sigma) else f"{sigma:.2g}", rest]
         if true_values is not None:
             true = float(true_values[i])
             row += [f"{true:.6g}", f"{(value - true) / sigma:+.2f}" if sigma > 0 else "n/a"]
         table.add_row(*row)
-    matrix, offset = cal.correction
     canon = Table()
     for label in ("matrix", "", "", "offset"):
         canon.add_column(label, justify="right")
@@ -140,6 +147,8 @@ def _params_table(run, truth=None):
 
 
 def _print_calibration(run, truth=None) -> None:
+    import numpy as np
+
     from ..segmentation import describe_found
     from ..units import from_rad_s
 
@@ -148,8 +157,13 @@ def _print_calibration(run, truth=None) -> None:
     ref = (f"speed {from_rad_s(run.reference_value, cal.output_units):g} {cal.output_units}"
            if run.reference == "speed" else f"angle {math.degrees(run.reference_value):g} deg per turn")
     console.print(f"{cal.method}, {ref}: g = diag(k) (m + b), the servo method of Wang et al., eq. 1",
-                  highlight=False)
+                  highlight=False, soft_wrap=True)
     console.print(table)
+    if cal.input_units == "counts" and cal.sensitivity is not None:
+        k = np.asarray(cal.model.params[:3])
+        console.print(f"k is relative to --sensitivity {cal.sensitivity:g} LSB per {cal.output_units}: the measured "
+                      f"sensitivity is {', '.join(f'{cal.sensitivity / v:.5g}' for v in k)} LSB per "
+                      f"{cal.output_units} (x, y, z)", highlight=False, soft_wrap=True)
     console.print(f"correction w_true = matrix @ (raw - offset), raw in {cal.input_units}, "
                   f"w_true in {cal.output_units}", highlight=False)
     console.print(canon)
@@ -192,7 +206,8 @@ def _truth_calibration(path: Path, cal):
     from ..simulation.truth import SimulationTruth
 
     truth = load(path, SimulationTruth)
-    return Calibration(model=truth.model, input_units=cal.input_units, output_units=cal.output_units)
+    return Calibration(model=truth.model, input_units=cal.input_units, output_units=cal.output_units,
+                       sensitivity=cal.sensitivity)
 
 
 @app.command()
@@ -200,6 +215,7 @@ def calibrate(
     recording: Annotated[Optional[Path], typer.Argument(help="Recording: CSV, Parquet, or a ROS/MCAP bag.")] = None,
     units: READING.Units = None,
     columns: READING.Columns = None,
+    skip_rows: READING.SkipRows = None,
     sample_rate: READING.SampleRate = None,
     sensitivity: READING.Sensitivity = None,
     output_units: READING.OutputUnits = None,
@@ -211,15 +227,17 @@ def calibrate(
     windows: WindowsFile = None,
     method: Annotated[Method, typer.Option("--method", help="Estimator.")] = "first-moment",
     noise_std: Annotated[Optional[float], typer.Option(
-        "--noise-std", help="Per-sample noise, in the data's unit, instead of the one measured.")] = None,
+        "--noise-std", help="Per-sample noise, in the data's unit, instead of the one measured (default: "
+        "measured).")] = None,
     noise_density: Annotated[Optional[str], typer.Option(
         "--noise-density", help="Noise density instead of the one measured: a number [rad/s/sqrt(Hz)], "
-        "'N deg/s/rtHz', or a noise JSON from 'gyrocal noise --json'.")] = None,
+        "'N deg/s/rtHz', or a noise JSON from 'gyrocal noise --json' (default: measured).")] = None,
     output: Output = None,
     plot: PlotPath = None,
     force: Force = False,
     example: Annotated[bool, typer.Option(
-        "--example", help="Run on the bundled simulated MPU9250 servo recording (60 deg/s).")] = False,
+        "--example", help="Run on the bundled simulated MPU9250 servo recording (deg/s, --speed 60 unless "
+        "--angle or --windows).")] = False,
 ) -> None:
     """Estimate scale and bias from a recording of turns; print them with 1-sigma; write the calibration file."""
     from ..pipeline import calibrate as run_calibration
@@ -239,8 +257,9 @@ def calibrate(
     units = required_units(units)
     rate_unit = _rate_unit(units, output_units)
     reference, speed_rad, angle_rad = _reference(speed, angle, rate_unit)
-    rec = read_from_flags(recording, units=units, columns=columns, sample_rate=sample_rate, sensitivity=sensitivity,
-                          output_units=output_units, topic=topic, saturation=saturation, no_unit_check=no_unit_check)
+    rec = read_from_flags(recording, units=units, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
+                          sensitivity=sensitivity, output_units=output_units, topic=topic, saturation=saturation,
+                          no_unit_check=no_unit_check)
     win = _windows_from_file(windows, rec)
     noise = _noise_to_internal(noise_std, units, rate_unit, sensitivity)
     if noise_density is not None:
@@ -282,6 +301,7 @@ def segments(
     recording: Annotated[Path, typer.Argument(help="Recording: CSV, Parquet, or a ROS/MCAP bag.")],
     units: READING.Units = None,
     columns: READING.Columns = None,
+    skip_rows: READING.SkipRows = None,
     sample_rate: READING.SampleRate = None,
     sensitivity: READING.Sensitivity = None,
     output_units: READING.OutputUnits = None,
@@ -294,6 +314,7 @@ def segments(
     plot: PlotPath = None,
 ) -> None:
     """Show the rotation and static windows detected (or read from --windows) and what was ignored and why."""
+    # long function: the command's output in the order it is printed (time base, windows, what was ignored)
     from rich.markup import escape
     from rich.table import Table
 
@@ -301,8 +322,9 @@ def segments(
     rate_unit = _rate_unit(units, output_units)
     reference, speed_rad, angle_rad = _reference(speed, angle, rate_unit)
     check_output(plot, flag="--plot", inputs=(recording, windows), force=True)
-    rec = read_from_flags(recording, units=units, columns=columns, sample_rate=sample_rate, sensitivity=sensitivity,
-                          output_units=output_units, topic=topic, saturation=saturation, no_unit_check=no_unit_check)
+    rec = read_from_flags(recording, units=units, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
+                          sensitivity=sensitivity, output_units=output_units, topic=topic, saturation=saturation,
+                          no_unit_check=no_unit_check)
     given = _windows_from_file(windows, rec)
     ignored: list = []
     if given is not None:

@@ -157,19 +157,19 @@ def capture(
     wire: Annotated[CaptureWire, typer.Option("--wire", help="Wire format: auto, frames (gyrocal frames) or text "
                                       "(lines such as t,gx,gy,gz).")] = "auto",
     columns: Annotated[str | None, typer.Option("--columns", help="Text lines without a header: column "
-                                                   "numbers from 1, e.g. t=1,gx=2,gy=3,gz=4.")] = None,
+                                                   "numbers from 1, e.g. t=1,gx=2,gy=3,gz=4 (default: the header's names).")] = None,
     units: Annotated[InputUnit, typer.Option("--units", help="Unit of the rates received: counts, deg/s or rad/s "
                                        "(frames always send counts).")] = "counts",
     sensitivity: Annotated[float | None, typer.Option("--sensitivity", help="Counts per deg/s (frames: the "
-                                                         "device says).")] = None,
+                                                         "device says) (default: none; counts are kept).")] = None,
     sample_rate: Annotated[float | None, typer.Option("--sample-rate", help="[Hz], for text lines without "
-                                                         "a time column.")] = None,
-    duration: Annotated[float | None, typer.Option("--duration", help="Stop after S seconds of data.")] = None,
-    samples: Annotated[int | None, typer.Option("--samples", help="Stop after N samples.")] = None,
+                                                         "a time column (default: from the time column).")] = None,
+    duration: Annotated[float | None, typer.Option("--duration", help="Stop after S seconds of data (default: no limit).")] = None,
+    samples: Annotated[int | None, typer.Option("--samples", help="Stop after N samples (default: no limit).")] = None,
     silence: Annotated[float | None, typer.Option("--silence", help="Stop after S seconds without a "
-                                                     "byte.")] = None,
+                                                     "byte (default: no limit).")] = None,
     guide: Annotated[GuideName | None, typer.Option("--guide", help="Guided session: servo (the six turns of the "
-                                                 "servo method of Wang et al.) or hand.")] = None,
+                                                 "servo method of Wang et al.) or hand (default: none, plain recording).")] = None,
     speed: Annotated[float | None, typer.Option("--speed", help="Known turn speed [deg/s] (servo); default "
                                                    "whole 360 deg turns at any speed.")] = None,
     calibration: Annotated[Path | None, typer.Option("--cal", help="Calibration file to write when the "
@@ -219,6 +219,11 @@ def _finish(result, port, units, sensitivity, sample_rate, guided, cal_path, spe
     elif guided is not None:
         warn(f"the guided session stopped at step {guided.guide.index + 1} of {len(guided.guide.steps)}; "
              "no calibration written (the recording is complete)")
+    else:
+        how = f"--units {units}" + (f" --sensitivity {sens:g}" if units == "counts" and sens else "")
+        how += "" if result.store.has_time else f" --sample-rate {sample_rate:g}" if sample_rate else " --sample-rate HZ"
+        console.print(f"next: gyrocal calibrate {result.path} {how} --angle 360 -o cal.json", highlight=False,
+                      soft_wrap=True, markup=False)
     agreement = device_check(result)
     if agreement is None:
         return

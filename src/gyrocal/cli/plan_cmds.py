@@ -42,15 +42,19 @@ def plan(
     design: Annotated[DesignName, typer.Option(
         "--design", help="six (the servo method of Wang et al., Fig. 1), six-static, twelve.")] = "six",
     sample_rate: Annotated[float, typer.Option("--sample-rate", help="Sampling rate [Hz].")] = 200.0,
-    noise: Annotated[Optional[float], typer.Option("--noise", help="Per-sample white noise [rad/s].")] = None,
+    noise: Annotated[Optional[float], typer.Option(
+        "--noise", help="Per-sample white noise [rad/s] (default: 0.035, the paper's simulations).")] = None,
     noise_density: NoiseDensity = None,
-    k: Annotated[Optional[str], typer.Option("--k", help="Expected scale factors kx,ky,kz.")] = None,
+    k: Annotated[Optional[str], typer.Option(
+        "--k", help="Expected scale factors kx,ky,kz (default: 1,1,1).")] = None,
     wait: Annotated[float, typer.Option("--wait", help="Wait between turns (static window for six-static) [s].")]
     = 3.0,
-    target_scale: Annotated[Optional[float], typer.Option("--target-scale", help="Target std of every k [-].")]
+    target_scale: Annotated[Optional[float], typer.Option(
+        "--target-scale", help="Target std of every k [-] (default: none; no suggestion).")]
     = None,
     target_bias: Annotated[Optional[str], typer.Option(
-        "--target-bias", help="Target std of every bias, e.g. 0.01deg/s (default unit rad/s).")] = None,
+        "--target-bias", help="Target std of every bias, e.g. 0.01deg/s (unit rad/s if none given) (default: "
+        "none; no suggestion).")] = None,
     max_speed: Annotated[float, typer.Option("--max-speed", help="Fastest speed to consider [deg/s].")] = 180.0,
 ) -> None:
     """Predict each parameter's std and the protocol time; suggest the fastest protocol for a target."""

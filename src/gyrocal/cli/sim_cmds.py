@@ -28,9 +28,17 @@ _PROTOCOL_FLAGS = {
     **dict.fromkeys(("vibration", "ripple", "ripple_freq"), ("servo",)),
     # the turntable gyro follows the full-temperature-range method's thermal truth
     **dict.fromkeys(("k", "b"), (*_SERVO, "profile")),
-    **dict.fromkeys(("temps", "rates", "step_duration", "temp_noise", "temp_quantum"), ("turntable",)),
-    **dict.fromkeys(("profile", "profile_units", "duration"), ("profile",)),
+    **dict.fromkeys(("temps", "rates", "step_duration"), ("turntable",)),
+    **dict.fromkeys(("temp_noise", "temp_quantum"), ("turntable", "static")),
+    **dict.fromkeys(("profile", "profile_units"), ("profile",)),
+    "duration": ("profile", "static"),
+    **dict.fromkeys(("temp_start", "temp_end", "warmup_tau", "bias_tempco", "accel_noise_density",
+                     "accel_random_walk"), ("static",)),
+    # a reference log needs turns about several axes, which the single-axis turntable does not make
+    "reference": (*_SERVO, "profile"),
 }
+#: Flags that describe the reference log, so they need --reference.
+_REFERENCE_FLAGS = ("ref_sample_rate", "ref_offset", "ref_drift", "ref_mounting", "ref_noise", "ref_units")
 
 
 def _turntable_protocol(temps: str | None, rates: str | None, step_duration: float | None, temp_noise: float,
@@ -52,7 +60,7 @@ def _turntable_protocol(temps: str | None, rates: str | None, step_duration: flo
 def simulate(
     ctx: typer.Context,
     output: Annotated[Path | None, typer.Option(
-        "-o", "--output", help="Recording to write (CSV); the truth goes to *.truth.json.")] = None,
+        "-o", "--output", help="Recording to write (CSV); the truth goes to *.truth.json (required, except with --device).")] = None,
     protocol: Annotated[Protocol, typer.Option("--protocol", help="Motion source.")] = "servo",
     speed: Annotated[float, typer.Option("--speed", help="Servo/hand turn speed [deg/s].")] = 60.0,
     turns: Annotated[str, typer.Option("--turns", help="Turns, comma-separated.")] = "+x,-x,+y,-y,+z,-z",
@@ -61,18 +69,36 @@ def simulate(
     vibration: Annotated[float, typer.Option("--vibration", help="RMS speed vibration, fraction of speed.")] = 0.05,
     misalignment: Annotated[float, typer.Option("--misalignment", help="Mounting misalignment [deg], <= 10.")] = 5.0,
     k: Annotated[Optional[str], typer.Option(
-        "--k", help="True scale factors kx,ky,kz (the servo method of Wang et al., eq. 1).")] = None,
+        "--k", help="True scale factors kx,ky,kz (the servo method of Wang et al., eq. 1) (default: 1,1,1).")] = None,
     b: Annotated[Optional[str], typer.Option(
-        "--b", help="True biases bx,by,bz [rad/s] (the servo method of Wang et al., eq. 1).")] = None,
-    noise: Annotated[Optional[float], typer.Option("--noise", help="Per-sample white noise [rad/s].")] = None,
+        "--b", help="True biases bx,by,bz [rad/s] (the servo method of Wang et al., eq. 1) (default: 0,0,0).")] = None,
+    noise: Annotated[Optional[float], typer.Option("--noise", help="Per-sample white noise [rad/s] (default: 0.035, the paper's; 0.005 for the turntable).")] = None,
     noise_density: NoiseDensity = None,
     bias_instability: Annotated[float, typer.Option("--bias-instability", help="Gauss-Markov bias std [rad/s].")] = 0.0,
     rate_random_walk: Annotated[float, typer.Option("--rrw", help="Rate random walk [rad/s/sqrt(s)].")] = 0.0,
-    quantum: Annotated[Optional[float], typer.Option("--quantum", help="Output resolution [rad/s].")] = None,
-    full_scale: Annotated[Optional[float], typer.Option("--full-scale", help="Saturation [deg/s].")] = None,
-    profile: Annotated[Optional[Path], typer.Option("--profile", help="--protocol profile: CSV of t,wx,wy,wz.")] = None,
+    quantum: Annotated[Optional[float], typer.Option("--quantum", help="Output resolution [rad/s] (default: none, not quantised).")] = None,
+    full_scale: Annotated[Optional[float], typer.Option("--full-scale", help="Saturation [deg/s] (default: none, never saturates).")] = None,
+    profile: Annotated[Optional[Path], typer.Option("--profile", help="--protocol profile: CSV of t,wx,wy,wz (required there).")] = None,
     profile_units: Annotated[str, typer.Option("--profile-units", help="Unit of the profile rates.")] = "rad/s",
-    duration: Annotated[Optional[float], typer.Option("--duration", help="--protocol profile: length [s].")] = None,
+    duration: Annotated[Optional[float], typer.Option(
+        "--duration", help="--protocol profile, static: length [s] (required there).")] = None,
+    temp_start: Annotated[float, typer.Option(
+        "--temp-start", help="--protocol static: temperature at power-on [degC].")] = 25.0,
+    temp_end: Annotated[float, typer.Option(
+        "--temp-end", help="--protocol static: temperature the board warms to [degC] (= --temp-start: no warm-up).")]
+    = 25.0,
+    warmup_tau: Annotated[float, typer.Option(
+        "--warmup-tau", help="--protocol static: time constant of the exponential warm-up [s].")] = 600.0,
+    bias_tempco: Annotated[Optional[str], typer.Option(
+        "--bias-tempco", help="--protocol static: bias against temperature, x,y,z [rad/s/degC^n] for n = 1, 2, .. "
+                              "about 25 degC, ';' between powers, e.g. 1e-4,-5e-5,2e-5;1e-6,0,0 (default: none, "
+                              "no temperature dependence).")] = None,
+    accel_noise_density: Annotated[Optional[float], typer.Option(
+        "--accel-noise-density", help="--protocol static: also an accelerometer (gravity on z), white noise "
+                                      "[m/s^2/sqrt(Hz)] (default: none, no accelerometer).")] = None,
+    accel_random_walk: Annotated[Optional[float], typer.Option(
+        "--accel-random-walk", help="--protocol static: accelerometer bias random walk [m/s^3/sqrt(Hz)] (default: "
+                                    "none, no accelerometer; 0 with --accel-noise-density).")] = None,
     temps: Annotated[Optional[str], typer.Option(
         "--temps", help="--protocol turntable: temperatures [degC], comma-separated (default: the full-temperature-"
                         "range method's Table 1, -40 to 50 by 10).")] = None,
@@ -83,9 +109,9 @@ def simulate(
         "--step-duration", help="--protocol turntable: length of each rate step [s] (default: 60, the paper's).")]
     = None,
     temp_noise: Annotated[float, typer.Option(
-        "--temp-noise", help="--protocol turntable: std of each temperature reading [degC].")] = 0.0,
+        "--temp-noise", help="--protocol turntable, static: std of each temperature reading [degC].")] = 0.0,
     temp_quantum: Annotated[Optional[float], typer.Option(
-        "--temp-quantum", help="--protocol turntable: resolution of the temperature readings [degC], e.g. 1.")]
+        "--temp-quantum", help="--protocol turntable, static: resolution of the temperature readings [degC], e.g. 1 (default: none, not quantised).")]
     = None,
     revolutions: Annotated[Optional[str], typer.Option(
         "--revolutions", help="Servo/hand: revolutions of each turn, one number or one per turn (0.375,0.5,0.75 = "
@@ -104,6 +130,20 @@ def simulate(
     sample_rate: Annotated[float, typer.Option("--sample-rate", help="Sampling rate [Hz].")] = 200.0,
     units: Annotated[str, typer.Option("--units", help="Unit of the written gyro columns.")] = "deg/s",
     seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
+    reference: Annotated[Optional[Path], typer.Option(
+        "--reference", help="Also write the log of a reference gyro on the same motion (its own clock, mount, rate "
+                            "and noise; the truth goes to the sidecar), for planning 'gyrocal verify' (default: none).")] = None,
+    ref_sample_rate: Annotated[float, typer.Option("--ref-sample-rate", help="Reference rate [Hz].")] = 100.0,
+    ref_offset: Annotated[float, typer.Option(
+        "--ref-offset", help="Clock offset [s]: t_test = t_ref * (1 + drift) + offset.")] = 0.0,
+    ref_drift: Annotated[float, typer.Option("--ref-drift", help="Clock drift of the test clock [ppm].")] = 0.0,
+    ref_mounting: Annotated[float, typer.Option(
+        "--ref-mounting", help="Angle of the mounting rotation between the sensors [deg], axis drawn at random.")]
+    = 0.0,
+    ref_noise: Annotated[Optional[float], typer.Option(
+        "--ref-noise", help="Reference white noise per sample [rad/s] (default: an ADIS16465, 0.0025 deg/s/sqrt(Hz)).")]
+    = None,
+    ref_units: Annotated[str, typer.Option("--ref-units", help="Unit of the reference's gyro columns.")] = "deg/s",
     force: Annotated[bool, typer.Option("--force", help="Replace an -o file that gyrocal simulate did not write.")]
     = False,
     device: Annotated[bool, typer.Option(
@@ -113,90 +153,116 @@ def simulate(
     wire: Annotated[DeviceWire, typer.Option("--wire", help="--device: gyrocal frames or text lines.")] = "frames",
     faults: Annotated[str | None, typer.Option(
         "--faults", help="--device: drop=P,corrupt=P (per byte),stall=AT:SECONDS,disconnect=AT (AT: fraction of "
-                         "the stream).")] = None,
+                         "the stream) (default: none).")] = None,
     pace: Annotated[float, typer.Option(
         "--pace", help="--device: 1 = real time, 10 = ten times faster, 0 = as fast as the reader reads.")] = 1.0,
 ) -> None:
-    """Simulate a recording (servo, hand, turntable or profile) with its truth sidecar."""
+    """Simulate a recording (servo, hand, turntable, profile or static) with its truth sidecar."""
     import numpy as np
 
     from ..files import save
     from ..io import write_recording
     from ..models import ScaleBias
-    from ..simulation import VirtualGyro
     from ..simulation.truth import SimulationTruth, truth_path
     from ..units import parse_rate_unit
 
     refuse_unused(ctx, _PROTOCOL_FLAGS, protocol, "--protocol")
+    _refuse_reference_flags(ctx, reference)
+    if device and reference is not None:
+        raise InputError("--reference writes a second log; it does not go with --device (leave one out)")
     if device:
         return _serve_device(protocol, speed, turns, wait, misalignment, k, b, noise, noise_density, sample_rate,
                              seed, wire, faults, pace)
     for name in ("wire", "faults", "pace"):
         if given(ctx, name):
             raise InputError(f"--{name} is for --device only; add --device or leave --{name} out")
-    if output is None:
-        raise InputError("give -o FILE.csv for the recording (or --device to serve a session on a pseudo-terminal)")
-    truth_file = truth_path(output)
-    check_output(output, inputs=(profile,), force=force, replaceable=starts_with(f"# {_SIMULATED}"))
-    check_output(truth_file, flag="truth file", inputs=(profile,), force=force,
-                 replaceable=json_format(SimulationTruth.FORMAT))
+    truth_file = _check_outputs(output, truth_path(output) if output else None, reference, profile, force)
     unit = parse_rate_unit(units)
     rng = np.random.default_rng(seed)
-    sd = noise_std(noise, noise_density, sample_rate, 0.035 if protocol != "turntable" else 0.005)
+    sd = noise_std(noise, noise_density, sample_rate, 0.035 if protocol not in ("turntable", "static") else 0.005)
     model = ScaleBias(triple("--k", k, (1.0, 1.0, 1.0)), triple("--b", b, (0.0, 0.0, 0.0)))
     gyro_kw = dict(noise_std=tuple(sd), bias_instability=bias_instability, rate_random_walk=rate_random_walk,
                    quantum=quantum, full_scale=None if full_scale is None else math.radians(full_scale))
     settings = {"sample_rate": sample_rate, "noise_std": sd.tolist(), "bias_instability": bias_instability,
                 "rate_random_walk": rate_random_walk, "quantum": quantum, "full_scale_deg_s": full_scale,
                 "seed": seed, "units": unit}
-    facts: dict = {}
     if protocol in _SERVO:
-        from ..simulation.servo import ServoProtocol, simulate_servo
-        from ..simulation.truth import servo_facts
-
-        turn_list = tuple(t.strip() for t in turns.split(",") if t.strip())
-        revs = 1.0 if revolutions is None else tuple(numbers("--revolutions", revolutions))
-        kw = dict(speed=math.radians(speed), wait=wait, ramp=ramp, misalignment_deg=misalignment,
-                  revolutions=revs[0] if isinstance(revs, tuple) and len(revs) == 1 else revs)
-        proto = (ServoProtocol.hand(turn_list, **kw) if protocol == "hand"
-                 else ServoProtocol(turns=turn_list, vibration=vibration, ripple=ripple, ripple_freq=ripple_freq, **kw))
-        rec, truth = simulate_servo(VirtualGyro(model, **gyro_kw), proto, sample_rate=sample_rate, rng=rng)
-        settings.update(speed_deg_s=speed, turns=list(turn_list), wait_s=wait, ramp_s=ramp, vibration=vibration,
-                        misalignment_deg=misalignment, revolutions=[float(r) for r in proto.turn_angles() / (2 * math.pi)],
-                        ripple=ripple, ripple_freq_hz=ripple_freq)
-        facts = servo_facts(truth)
+        rec, facts, true_rates = _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misalignment,
+                                        sample_rate, rng, settings, revolutions=revolutions, ripple=ripple,
+                                        ripple_freq=ripple_freq)
     elif protocol == "turntable":
-        from ..models import Affine
-        from ..simulation.thermal_truth import ThermalTruth
-        from ..simulation.turntable import simulate_turntable
-
-        proto = _turntable_protocol(temps, rates, step_duration, temp_noise, temp_quantum)
-        thermal = ThermalTruth()
-        K, B = thermal(np.array([thermal.ref_temp]))
-        model = Affine(K[0], B[0])
-        rec = simulate_turntable(VirtualGyro(model, thermal=thermal, **gyro_kw), proto, sample_rate=sample_rate,
-                                 rng=rng)
-        settings.update(temps_degC=list(proto.temps), rates_deg_s=list(proto.rates), axes=list(proto.axes),
-                        step_duration_s=proto.step_duration, table_tau_s=proto.table_tau,
-                        temp_noise_degC=proto.temp_noise, temp_quantum_degC=proto.temp_quantum)
-        facts = {"thermal": thermal.to_dict()}
+        rec, model, facts = _turntable(gyro_kw, _turntable_protocol(temps, rates, step_duration, temp_noise,
+                                                                     temp_quantum), sample_rate, rng, settings)
+    elif protocol == "static":
+        rec, facts = _static(gyro_kw, ctx.params, sample_rate, rng, settings)
     else:
-        from ..io import read_profile
-        from ..simulation.profiles import simulate_profile
-
-        if profile is None or duration is None:
-            raise InputError("--protocol profile needs --profile FILE.csv and --duration SECONDS")
-        rec, _ = simulate_profile(VirtualGyro(model, **gyro_kw), read_profile(profile, units=profile_units),
-                                  duration=duration, sample_rate=sample_rate, rng=rng)
-        settings.update(profile=str(profile), duration_s=duration)
+        rec, facts, true_rates = _profile(model, gyro_kw, profile, profile_units, duration, sample_rate, rng,
+                                          settings)
+    ref_rec = None
+    if reference is not None:
+        ref_rec, facts["reference"] = _reference_log(rec.t, true_rates, reference, rng, sample_rate=ref_sample_rate,
+                                                     offset=ref_offset, drift=ref_drift, mounting=ref_mounting,
+                                                     noise=ref_noise)
     if stamps == "receive" or gaps:
+        if reference is not None:
+            raise InputError("--reference is written on the true clock; give it or --stamps receive/--gaps, not both")
         rec, facts = _time_defects(rec, facts, settings, stamps, late_per_minute, gaps, gap_length, rng)
     elif given(ctx, "late_per_minute"):
         raise InputError("--late-per-minute is for --stamps receive; add it or leave --late-per-minute out")
     write_recording(output, rec, units=unit,
                     header_comment=f"{_SIMULATED} --protocol {protocol}; gyro in {unit}, t in s")
+    if ref_rec is not None:
+        ref_unit = parse_rate_unit(ref_units, "ref_units")
+        write_recording(reference, ref_rec, units=ref_unit,
+                        header_comment=f"{_SIMULATED} reference of {output.name}; gyro in {ref_unit}, t in s "
+                                       "on the reference clock")
     save(SimulationTruth(protocol=protocol, model=model, settings=settings, facts=facts), truth_file)
-    console.print(f"wrote {output} ({len(rec)} samples, {len(rec) / sample_rate:.1f} s, {unit}) and {truth_file}")
+    also = "" if reference is None else f", {reference} ({len(ref_rec)} samples at {ref_sample_rate:g} Hz)"
+    console.print(f"wrote {output} ({len(rec)} samples, {len(rec) / sample_rate:.1f} s, {unit}){also} and "
+                  f"{truth_file}", highlight=False)
+
+
+def _check_outputs(output: Path | None, truth_file: Path | None, reference: Path | None, profile: Path | None,
+                   force: bool) -> Path:
+    """Refuse outputs that would destroy something, before anything is simulated; the truth file's path."""
+    from ..simulation.truth import SimulationTruth
+
+    if output is None or truth_file is None:
+        raise InputError("give -o FILE.csv for the recording (or --device to serve a session on a pseudo-terminal)")
+    check_output(output, inputs=(profile,), force=force, replaceable=starts_with(f"# {_SIMULATED}"))
+    check_output(truth_file, flag="truth file", inputs=(profile,), force=force,
+                 replaceable=json_format(SimulationTruth.FORMAT))
+    if reference is not None:
+        check_output(reference, flag="--reference", inputs=(profile, output, truth_file), force=force,
+                     replaceable=starts_with(f"# {_SIMULATED}"))
+    return truth_file
+
+
+def _refuse_reference_flags(ctx: typer.Context, reference: Path | None) -> None:
+    """A --ref-* flag without --reference would be silently ignored: refuse it."""
+    if reference is not None:
+        return
+    for name in _REFERENCE_FLAGS:
+        if given(ctx, name):
+            raise InputError(f"--{name.replace('_', '-')} describes the reference log; add --reference REF.csv")
+
+
+def _reference_log(t, true_rates, path: Path, rng, *, sample_rate: float, offset: float, drift: float,
+                   mounting: float, noise: float | None):
+    """The reference recording and its truth for the sidecar (reference flags name themselves in errors)."""
+    from .._validation import at_least
+    from ..models import ScaleBias
+    from ..simulation import VirtualGyro
+    from ..simulation.reference import ADIS16465_NOISE_DENSITY, simulate_reference
+    from ._reading import prefixed_params
+
+    with prefixed_params("ref_"):
+        sd = ADIS16465_NOISE_DENSITY * math.sqrt(sample_rate) if noise is None else at_least("noise_std", noise, 0.0,
+                                                                                              " rad/s")
+        gyro = VirtualGyro(ScaleBias((1.0, 1.0, 1.0), (0.0, 0.0, 0.0)), noise_std=sd)
+        rec, truth = simulate_reference(t, true_rates, gyro, sample_rate=sample_rate, time_offset_s=offset,
+                                        clock_drift_ppm=drift, mounting_deg=mounting, rng=rng)
+    return rec, {"path": path.name, **truth.to_dict()}
 
 
 def _time_defects(rec, facts: dict, settings: dict, stamps: str, late_per_minute: float, gaps: int,
@@ -252,3 +318,88 @@ def _serve_device(protocol, speed, turns, wait, misalignment, k, b, noise, noise
         while not dev.wait(1.0):
             pass
     console.print(f"sent {dev.sent:,} bytes; the device closed the link", highlight=False)
+
+
+def _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misalignment, sample_rate, rng, settings,
+           *, revolutions: str | None = None, ripple: float = 0.0, ripple_freq: float = 2.5):
+    """A servo or hand session: the recording, its facts and true rates; `settings` gains the protocol's."""
+    from ..simulation import VirtualGyro
+    from ..simulation.servo import ServoProtocol, simulate_servo
+    from ..simulation.truth import servo_facts
+
+    turn_list = tuple(t.strip() for t in turns.split(",") if t.strip())
+    revs = (1.0,) if revolutions is None else tuple(numbers("--revolutions", revolutions))
+    kw = dict(speed=math.radians(speed), wait=wait, ramp=ramp, misalignment_deg=misalignment,
+              revolutions=revs[0] if len(revs) == 1 else revs)
+    proto = (ServoProtocol.hand(turn_list, **kw) if protocol == "hand"
+             else ServoProtocol(turns=turn_list, vibration=vibration, ripple=ripple, ripple_freq=ripple_freq, **kw))
+    rec, truth = simulate_servo(VirtualGyro(model, **gyro_kw), proto, sample_rate=sample_rate, rng=rng)
+    settings.update(speed_deg_s=speed, turns=list(turn_list), wait_s=wait, ramp_s=ramp, vibration=vibration,
+                    misalignment_deg=misalignment, revolutions=[float(r) for r in proto.turn_angles() / (2 * math.pi)],
+                    ripple=ripple, ripple_freq_hz=ripple_freq)
+    return rec, servo_facts(truth), truth.rates
+
+
+def _turntable(gyro_kw, proto, sample_rate, rng, settings):
+    """A turntable session of a gyro following the thermal truth: recording, model at 25 degC, facts."""
+    import numpy as np
+
+    from ..models import Affine
+    from ..simulation import VirtualGyro
+    from ..simulation.thermal_truth import ThermalTruth
+    from ..simulation.turntable import simulate_turntable
+
+    thermal = ThermalTruth()
+    K, B = thermal(np.array([thermal.ref_temp]))
+    model = Affine(K[0], B[0])
+    rec = simulate_turntable(VirtualGyro(model, thermal=thermal, **gyro_kw), proto, sample_rate=sample_rate, rng=rng)
+    settings.update(temps_degC=list(proto.temps), rates_deg_s=list(proto.rates), axes=list(proto.axes),
+                    step_duration_s=proto.step_duration, table_tau_s=proto.table_tau,
+                    temp_noise_degC=proto.temp_noise, temp_quantum_degC=proto.temp_quantum)
+    return rec, model, {"thermal": thermal.to_dict()}
+
+
+def _profile(model, gyro_kw, profile, profile_units, duration, sample_rate, rng, settings):
+    """A recording of a rate profile read from a CSV file."""
+    from ..io import read_profile
+    from ..simulation import VirtualGyro
+    from ..simulation.profiles import simulate_profile
+
+    if profile is None or duration is None:
+        raise InputError("--protocol profile needs --profile FILE.csv and --duration SECONDS")
+    rec, true_rates = simulate_profile(VirtualGyro(model, **gyro_kw), read_profile(profile, units=profile_units),
+                                       duration=duration, sample_rate=sample_rate, rng=rng)
+    settings.update(profile=str(profile), duration_s=duration)
+    return rec, {}, true_rates
+
+
+def _static(gyro_kw, flags: dict, sample_rate, rng, settings):
+    """``--protocol static``: a board lying still, warming up when --temp-start and --temp-end differ."""
+    from ..models import ScaleBias
+    from ..simulation import BiasDrift, StillAccelerometer, StillProtocol, VirtualGyro, simulate_still
+
+    if flags["duration"] is None:
+        raise InputError("--protocol static needs --duration SECONDS")
+    tempco = flags["bias_tempco"]
+    rows = [numbers("--bias-tempco", part) for part in (tempco or "0,0,0").split(";")]
+    if any(len(r) != 3 for r in rows):
+        raise InputError(f"--bias-tempco takes triples x,y,z per power of (T - 25 degC), ';' between powers, "
+                         f"got {tempco!r}")
+    drift = BiasDrift([[0.0, *c] for c in zip(*rows)], ref_temp=25.0)
+    proto = StillProtocol(duration=flags["duration"], temp_start=flags["temp_start"], temp_end=flags["temp_end"],
+                          temp_tau=flags["warmup_tau"], temp_noise=flags["temp_noise"],
+                          temp_quantum=flags["temp_quantum"])
+    accel = None
+    if flags["accel_noise_density"] is not None or flags["accel_random_walk"] is not None:
+        accel = StillAccelerometer(flags["accel_noise_density"] or 0.0, flags["accel_random_walk"] or 0.0)
+    gyro = VirtualGyro(ScaleBias([1.0, 1.0, 1.0], [0.0, 0.0, 0.0]), thermal=drift, **gyro_kw)
+    rec, _ = simulate_still(gyro, proto, sample_rate=sample_rate, rng=rng, accel=accel)
+    settings.update(duration_s=proto.duration, temp_noise_degC=proto.temp_noise, temp_quantum_degC=proto.temp_quantum)
+    facts = {"still": {"temp_start_degC": proto.temp_start, "temp_end_degC": proto.temp_end,
+                       "warmup_tau_s": proto.temp_tau,
+                       "bias_tempco": {"ref_temp_degC": 25.0, "coefs": drift.coefs.tolist(),
+                                       "equation": "bias(T) = sum_n coefs[:, n] (T - 25)^n [rad/s]"},
+                       "accelerometer": None if accel is None else {
+                           "noise_density": accel.noise_density, "random_walk": accel.random_walk,
+                           "gravity": [0.0, 0.0, 9.80665]}}}
+    return rec, facts

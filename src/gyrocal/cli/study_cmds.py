@@ -34,7 +34,8 @@ def study(
     reps: Annotated[Optional[int], typer.Option("--reps", help="Calibrations per gyro (default: the paper's).")] = None,
     seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
     methods: Annotated[Optional[str], typer.Option(
-        "--methods", help="servo-speed: estimators, comma-separated (algorithm1, lm, first-moment).")] = None,
+        "--methods", help="servo-speed: estimators, comma-separated (algorithm1, lm, first-moment) (default: "
+        "all three).")] = None,
     noise_density: NoiseDensity = None,
     sample_rate: Annotated[float, typer.Option(
         "--sample-rate", help="Sampling rate [Hz] (thermal-compare's default: 100).")] = 200.0,
@@ -67,7 +68,7 @@ def study(
     if noise_density is not None:
         import numpy as np
 
-        from ..noise import noise_density_arg
+        from ..noise_file import noise_density_arg
 
         sd = float(np.mean(noise_density_arg(noise_density))) * math.sqrt(sample_rate)
         if settings is None:

@@ -13,17 +13,19 @@ import typer
 
 from ..choices import OutOfRange
 from ..errors import InputError
-from ._outputs import check_output, same_document
+from ._outputs import check_output, refuse_swapped, same_document
 from ._reading import READING
 from .app import app, console, warnings_as_lines
 
 __all__ = ["thermal", "thermal_report"]
 
 
-Units = Annotated[str, typer.Option("--units", help="Unit of the gyro and table_rate columns: rad/s, deg/s or counts.")]
+Units = Annotated[str, typer.Option("--units", help="Unit of the gyro and table_rate columns (required).",
+                                    metavar="<rad/s|deg/s|counts>")]
 Settle = Annotated[float, typer.Option("--settle", help="Time dropped at the start of every step (s).")]
 FullScale = Annotated[Optional[float], typer.Option(
-    "--full-scale", help="Gyro range in the data's unit; steps with samples at it are left out (with a warning).")]
+    "--full-scale", help="Gyro range in the data's unit; steps with samples at it are left out (with a warning) "
+    "(default: saturation found as runs of identical extreme readings).")]
 TempTol = Annotated[float, typer.Option(
     "--temp-tolerance", help="Spread allowed inside a step, and closest distinct temperature points (degC).")]
 
@@ -99,10 +101,10 @@ def thermal(
 def _print_table(cal, fit) -> None:
     import numpy as np
     from rich.box import SIMPLE
-
-    from ..units import unit_factor
     from rich.markup import escape
     from rich.table import Table
+
+    from ..units import unit_factor
 
     user = cal.kg_user
     std = cal.to_user(cal.std)  # 1-sigma in the table's units; below, the largest of each group of terms
@@ -133,7 +135,8 @@ def thermal_report(
     calibration: Annotated[Path, typer.Argument(help="Thermal calibration file from 'gyrocal thermal'.")],
     test: Annotated[Path, typer.Argument(help="Test recording (or folder) with t, gx, gy, gz, temp, table_rate, axis.")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Report folder to write.")],
-    units: Annotated[Optional[str], typer.Option("--units", help="Unit of the test data (default: the calibration's input unit).")] = None,
+    units: Annotated[Optional[str], typer.Option("--units", help="Unit of the test data (default: the calibration's input unit).",
+                                                          metavar="<rad/s|deg/s|counts>")] = None,
     columns: READING.Columns = None,
     sample_rate: READING.SampleRate = None,
     sensitivity: READING.Sensitivity = None,
@@ -148,8 +151,9 @@ def thermal_report(
     """Compare uncompensated, traditional, Lagrange and smooth compensation on a test recording."""
     from ..files import load_thermal
     from ..thermal.evaluate import evaluate
-    from ..thermal.report import write_report
+    from ..thermal_report import write_report
 
+    refuse_swapped(calibration, test, command="thermal-report", usage="thermal file from 'gyrocal thermal' comes")
     check_output(output, inputs=(calibration, test), folder=True)
     cal = load_thermal(calibration)
     units = units or cal.input_units

@@ -4,6 +4,7 @@ Each estimator holds only its configuration; ``fit`` returns a frozen
 :class:`FitResult` and ``fit_batch`` a :class:`BatchFit` over many gyros.
 """
 
+from ._checks import require_count, require_full_rank
 from ._result import BatchFit, FitResult, Method
 from .algorithm1 import Algorithm1, algorithm1_batch
 from .first_moment import FirstMoment, first_moment_batch
@@ -21,6 +22,8 @@ __all__ = [
     "first_moment_batch",
     "make_estimator",
     "paper_lm_batch",
+    "require_count",
+    "require_full_rank",
     "window_residuals",
 ]
 
@@ -31,5 +34,5 @@ def make_estimator(method: Method, **options):
 
     table = {"first-moment": FirstMoment, "algorithm1": Algorithm1, "lm": PaperLM}
     if method not in table:
-        raise InputError(f"method={method!r} is not one of {', '.join(table)}")
+        raise InputError(f"{{param}}={method!r} is not one of {', '.join(table)}", param="method", value=method)
     return table[method](**options)

@@ -1,4 +1,4 @@
-"""The first-moment estimator (SPEC, Method S): unbiased, with a data-driven covariance.
+"""The first-moment estimator (docs/core.md, Estimators): unbiased, with a data-driven covariance.
 
 Rotation windows give norm equations on the window mean,
 
@@ -221,7 +221,9 @@ def _lm_fit(obs: ObservationSet, nv: np.ndarray, max_iter: int) -> BatchFit:
         nu = row_noise_var(obs, nv)
         _, _, S0 = residuals_and_jacobian(p0, obs)
         scale = 1.0 / np.sqrt(row_variance(obs, S0, nu))
-    fun = lambda p: residuals_and_jacobian(p, obs, scale)[:2]
+
+    def fun(p):
+        return residuals_and_jacobian(p, obs, scale)[:2]
     p, iterations, converged, residuals, history = batched_lm(fun, p0, max_iter=max_iter)
     require_converged(converged, iterations, "first-moment least squares")
     # The norm equations cannot see the sign of k; a positive scale is the physical one.

@@ -67,7 +67,7 @@ def kb_covariance(beta: np.ndarray, obs: ObservationSet, X: np.ndarray) -> tuple
     correlated by ``2 mu_j s_j^2 / n``. A row ``beta0 + x . beta - y`` therefore has variance
     ``sum_j s_j^2 ((2 beta_j mu_j + beta_{j+3})^2 + 2 beta_j^2 s_j^2) / n``. The least-squares
     sandwich gives the covariance of ``beta``, and the delta method that of ``(k, b)``. It is
-    the spread over noise draws; the bias of the mean-of-squares form (SPEC) comes on top.
+    the spread over noise draws; the bias of the mean-of-squares form (docs/core.md, Accuracy) comes on top.
     """
     obs = obs.as_batch()
     nv = estimate_noise_var(obs)

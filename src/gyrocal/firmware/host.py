@@ -137,7 +137,8 @@ class _Obs(ctypes.Structure):
 
 _P = ctypes.POINTER
 _SIGNATURES = {
-    "gyrocal_correct": (None, [_P(_Affine), _P(ctypes.c_float), _P(ctypes.c_float)]),
+    "gyrocal_correct": (ctypes.c_int, [_P(_Affine), _P(ctypes.c_float), _P(ctypes.c_float)]),
+    "gyrocal_scale_bias_to_affine": (ctypes.c_int, [_P(_ScaleBias), _P(_Affine)]),
     "gyrocal_thermal_correct": (ctypes.c_int, [_P(_Thermal), ctypes.c_float, _P(ctypes.c_float), ctypes.c_uint,
                                                _P(ctypes.c_float)]),
     "gyrocal_temp_filter": (ctypes.c_float, [_P(ctypes.c_float), ctypes.c_float, ctypes.c_float]),
@@ -191,7 +192,7 @@ class CLibrary:
         m = _f32("raw", raw, (3,)).reshape(-1, 3)
         out = np.empty_like(m)
         for i in range(len(m)):
-            self.dll.gyrocal_correct(ctypes.byref(cal), _ptr(m[i]), _ptr(out[i]))
+            self._check(self.dll.gyrocal_correct(ctypes.byref(cal), _ptr(m[i]), _ptr(out[i])), "correction")
         return out
 
     def thermal_correct(self, temps, kg, temp, raw, clamp: bool = False) -> np.ndarray:

@@ -10,11 +10,10 @@ from .._validation import positive
 from ..choices import AccelUnit, SaturationPolicy, values
 from ..errors import InputError, NonFiniteInputError, SaturationError, UnitError
 from ..recording import Recording
+from ..saturation import find_saturation, stuck_runs
 from ..timebase import nominal_period
 from ..units import parse_input_unit, parse_rate_unit, unit_factor
 from ._columns import ACCEL, NUMERIC
-from ..saturation import find_saturation, stuck_runs
-
 
 #: No MEMS gyro measures beyond about 2000 deg/s (4000 for a few); above this, rad/s is a unit mistake.
 MAX_PLAUSIBLE_RAD_S = math.radians(2000.0)
@@ -85,31 +84,32 @@ def _check_units(raw: np.ndarray, unit: str, sensitivity: float | None, source: 
         if not np.array_equal(raw, np.round(raw)):
             i = int(np.argmax((raw != np.round(raw)).any(axis=1)))
             raise UnitError(
-                f"{source}: units are counts but data row {i + 1} holds non-integer readings {raw[i].tolist()}; "
-                "raw counts are integers: declare the rate unit instead (--units deg/s or rad/s)"
+                f"{source}: units are counts but data row {i + 1} holds non-integer readings {raw[i].tolist()}",
+                param="units", hint="raw counts are integers: declare the rate unit instead ({param} deg/s or rad/s)"
             )
     elif unit == "rad/s" and peak > MAX_PLAUSIBLE_RAD_S:
         raise UnitError(
-            f"{source}: rates reach {peak:.4g} rad/s ({math.degrees(peak):.4g} deg/s), beyond any MEMS gyro's range; "
-            "the data are almost surely in deg/s: use --units deg/s (or --no-unit-check)"
+            f"{source}: rates reach {peak:.4g} rad/s ({math.degrees(peak):.4g} deg/s), beyond any MEMS gyro's range",
+            param="units", hint="the data are almost surely in deg/s: use {param} deg/s (or {param:check_units})"
         )
     elif unit == "rad/s" and (noise := _noise(raw)) > MAX_PLAUSIBLE_NOISE_RAD_S:
         # slow turns in deg/s stay under the peak test, but their noise is 57 times too large
         raise UnitError(
-            f"{source}: the per-sample noise is {noise:.3g} rad/s, far above any MEMS gyro's (0.001-0.05); "
-            "the data are almost surely in deg/s: use --units deg/s (or --no-unit-check)"
+            f"{source}: the per-sample noise is {noise:.3g} rad/s, far above any MEMS gyro's (0.001-0.05)",
+            param="units", hint="the data are almost surely in deg/s: use {param} deg/s (or {param:check_units})"
         )
     elif unit == "deg/s" and peak > MAX_PLAUSIBLE_DEG_S and np.array_equal(raw, np.round(raw)):
         raise UnitError(
-            f"{source}: integer rates reach {peak:.6g} deg/s, beyond any MEMS gyro's range; "
-            "these look like raw counts: use --units counts (with --sensitivity if known)"
+            f"{source}: integer rates reach {peak:.6g} deg/s, beyond any MEMS gyro's range", param="units",
+            hint="these look like raw counts: use {param} counts (with {param:sensitivity} if known)"
         )
 
 
 def _check_saturation(raw, full_scale, policy: str, source: str, extremes) -> np.ndarray | None:
     """Rows to keep (None: all); `extremes` are each axis's (max, min)."""
     if policy not in ("error", "drop", "ignore"):
-        raise InputError(f"saturation={policy!r} is not accepted; use 'error', 'drop' or 'ignore'")
+        raise InputError(f"{{param}} {policy!r} is not accepted", param="saturation", value=policy,
+                         hint="use 'error', 'drop' or 'ignore'")
     if policy == "ignore":
         return None
     mask = find_saturation(raw, full_scale) if full_scale is not None else stuck_runs(raw, *extremes)
@@ -123,8 +123,8 @@ def _check_saturation(raw, full_scale, policy: str, source: str, extremes) -> np
     stop = rows[0] + int(np.argmax(np.r_[np.diff(rows) != 1, True]))
     raise SaturationError(
         f"{source}: axis {'xyz'[j]} is stuck at full scale (+-{level:.6g}) in {len(rows)} sample(s), "
-        f"first at data rows {rows[0] + 1}-{stop + 1}; those readings are not measurements: "
-        "record again with a larger range or slower turns, or drop them (saturation='drop', CLI --saturation drop)"
+        f"first at data rows {rows[0] + 1}-{stop + 1}; those readings are not measurements", param="saturation",
+        hint="record again with a larger range or slower turns, or drop them ({param} drop)"
     )
 
 
@@ -176,6 +176,12 @@ def _accel_fields(data: dict, source: str, accel_units: str | None, accel_sensit
             "accel_sensitivity": accel_sensitivity}
 
 
+def _axis_labels(values) -> np.ndarray:
+    """The axis column as text without surrounding blanks (one-letter labels have none to strip)."""
+    labels = np.asarray(values, dtype=str)
+    return labels if labels.dtype.itemsize == 4 else np.char.strip(labels)
+
+
 def build_recording(
     data: dict,
     extra: dict,
@@ -216,8 +222,8 @@ def build_recording(
         t, has_time = np.arange(n) / fs, False
     else:
         raise InputError(
-            f"{source}: no time column (t, time, timestamp, ...); give the sample rate "
-            "(sample_rate=HZ, CLI --sample-rate HZ) or map the time column (--columns t=NAME)"
+            f"{source}: no time column (t, time, timestamp, ...)", param="sample_rate",
+            hint="give the sample rate ({param} HZ) or map the time column ({param:columns} t=NAME)"
         )
     if check_units:
         _check_units(raw, unit, sensitivity, source, peak=max(float(hi.max()), -float(lo.min())))
@@ -235,7 +241,7 @@ def build_recording(
         "gyro": gyro,
         "temp": data.get("temp"),
         "table_rate": None if "table_rate" not in data else data["table_rate"] * table_factor,
-        "axis": None if "axis" not in data else np.char.strip(np.asarray(data["axis"], dtype=str)),
+        "axis": None if "axis" not in data else _axis_labels(data["axis"]),
         "extra": dict(extra),
         **accel,
     }

@@ -45,8 +45,8 @@ def to_float(values, column: str, source: str, *, decimal_comma: bool = False) -
             except ValueError:
                 hint = " (decimal comma? write 1.5, not 1,5)" if "," in cell else ""
                 raise InputError(
-                    f"{source}: column {column!r} holds non-numeric cell {str(cell)[:40]!r} at data row {i + 1}{hint}; "
-                    "fix the cell or map another column with --columns"
+                    f"{source}: column {column!r} holds non-numeric cell {str(cell)[:40]!r} at data row {i + 1}{hint}",
+                    param="columns", hint="fix the cell or map another column with {param}"
                 ) from None
         raise
 

@@ -54,14 +54,16 @@ def parse_columns(spec: str | Mapping[str, str] | None) -> dict[str, str]:
         for item in filter(None, (s.strip() for s in spec.split(","))):
             key, sep, value = item.partition("=")
             if not sep or not key.strip() or not value.strip():
-                raise InputError(f"columns entry {item!r} is not NAME=COLUMN; write for example 'gx=gyroX,gy=gyroY,gz=gyroZ'")
+                raise InputError(f"{{param}} entry {item!r} is not NAME=COLUMN", param="columns", value=item,
+                                 hint="write for example 'gx=gyroX,gy=gyroY,gz=gyroZ' (or column numbers, gx=2)")
             pairs[key.strip()] = value.strip()
         spec = pairs
     out = {}
     for key, value in dict(spec).items():
         canon = key.strip().lower()
         if canon not in CANONICAL:
-            raise InputError(f"columns key {key!r} is not a known quantity; use one of {', '.join(CANONICAL)}")
+            raise InputError(f"{{param}} key {key!r} is not a known quantity", param="columns", value=key,
+                             hint=f"use one of {', '.join(CANONICAL)}")
         out[canon] = str(value)
     return out
 
@@ -104,12 +106,12 @@ def resolve(names: Sequence[str], columns: Mapping[str, str] | None, source: str
     for canon, wanted in parse_columns(columns).items():
         hit = wanted if wanted in names else by_lower.get(wanted.strip().lower()) or _by_number(wanted, names)
         if hit is None:
-            raise InputError(f"{source}: column {wanted!r} (given for {canon}) is not in the file; {found}; "
-                             f"give a name or a number from 1 to {len(names)}")
+            raise InputError(f"{source}: column {wanted!r} (given for {canon}) is not in the file; {found}",
+                             param="columns", value=wanted, hint=f"in {{param}}, give a name or a number from 1 to {len(names)}")
         if hit in mapping.values():
             other = next(c for c, n in mapping.items() if n == hit)
-            raise InputError(f"{source}: column {hit!r} is given for both {other} and {canon}; each quantity needs "
-                             "its own column")
+            raise InputError(f"{source}: column {hit!r} is given for both {other} and {canon}", param="columns",
+                             hint="each quantity needs its own column")
         mapping[canon] = hit
     taken = set(mapping.values())
     for canon in CANONICAL if header else ():
@@ -124,10 +126,8 @@ def resolve(names: Sequence[str], columns: Mapping[str, str] | None, source: str
             mapping[canon] = hits[0]
             taken.add(hits[0])
         elif len(hits) > 1 and (canon in REQUIRED or canon == "t" or canon in ACCEL):
-            raise InputError(
-                f"{source}: several columns could be {canon} ({_found(hits)}); "
-                f"say which with columns, e.g. --columns {canon}={hits[0]}"
-            )
+            raise InputError(f"{source}: several columns could be {canon} ({_found(hits)})", param="columns",
+                             hint=f"say which with {{param}} {canon}={hits[0]}")
     missing = [c for c in REQUIRED if c not in mapping]
     accel_missing = [c for c in ACCEL if c not in mapping]
     if (accel or len(accel_missing) < 3) and accel_missing and not missing:
@@ -135,10 +135,10 @@ def resolve(names: Sequence[str], columns: Mapping[str, str] | None, source: str
             f"{source}: no accelerometer column for {', '.join(accel_missing)}; {found}",
             param="columns", hint="map them with {param} ax=NAME,ay=NAME,az=NAME")
     if missing:
-        how = ("by number, e.g. --columns gx=2,gy=3,gz=4" if not header else
-               "map them with --columns gx=NAME,gy=NAME,gz=NAME (or by number, gx=2), or, if the header is further "
-               "down, skip the lines above it (skip_rows=N)")
-        raise InputError(f"{source}: no column for {', '.join(missing)}; {found}; {how}")
+        how = ("give them by number, e.g. {param} gx=2,gy=3,gz=4" if not header else
+               "map them with {param} gx=NAME,gy=NAME,gz=NAME (or by number, gx=2), or, if the header is further "
+               "down, skip the lines above it with {param:skip_rows} N")
+        raise InputError(f"{source}: no column for {', '.join(missing)}; {found}", param="columns", hint=how)
     for canon, name in mapping.items():
         if names.count(name) > 1:  # readers would silently keep one of the copies
             raise InputError(

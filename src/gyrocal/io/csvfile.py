@@ -73,9 +73,10 @@ def _headerless(path: Path, lines: list[str], layout: Layout) -> InputError:
     numbers = "t=1,gx=2,gy=3,gz=4" if timed else "gx=1,gy=2,gz=3"
     sep = layout.delimiter or " "
     return InputError(
-        f"{path.name}: the first line ({first[:40].strip()!r}) is data, not a header; say which column holds what "
-        f"by number, counting from 1 (--columns {numbers}{'' if timed else ' with --sample-rate HZ'}), or add a "
-        f"header row naming the columns, e.g. {sep.join(('t', 'gx', 'gy', 'gz'))!r}"
+        f"{path.name}: the first line ({first[:40].strip()!r}) is data, not a header", param="columns",
+        hint=f"say which column holds what by number, counting from 1 ({{param}} {numbers}"
+             f"{'' if timed else ' with {param:sample_rate} HZ'}), or add a header row naming the columns, "
+             f"e.g. {sep.join(('t', 'gx', 'gy', 'gz'))!r}"
     )
 
 
@@ -86,7 +87,7 @@ def _mapped(path: Path, lines: list[str], layout: Layout, columns, accel: bool =
     if not columns and layout.header is not None and names == [str(i) for i in range(len(names))]:
         raise InputError(
             f"{path.name}: the header ({lines[layout.header][:40].strip()!r}) numbers the columns from 0, as pandas "
-            f"writes them; say which column holds what by those names, e.g. --columns t=0,gx=1,gy=2,gz=3"
+            "writes them", param="columns", hint="say which column holds what by those names, e.g. {param} t=0,gx=1,gy=2,gz=3"
         )
     error = None
     for reading in (layout, *layout.others):
@@ -162,6 +163,8 @@ def _read_arrow(path: Path, packed: str | None, layout: Layout, mapping: dict, e
     import pyarrow as pa
     import pyarrow.csv as pcsv
 
+    from ._arrow import numeric_to_numpy, text_to_numpy
+
     names = layout.names
     numeric = [mapping[c] for c in NUMERIC if c in mapping]
 
@@ -196,16 +199,17 @@ def _read_arrow(path: Path, packed: str | None, layout: Layout, mapping: dict, e
     rates = [mapping[c] for c in ("gx", "gy", "gz")]
     cols = {}
     if all(pa.types.is_float64(table.column(n).type) for n in rates):
-        # fill one (3, N) block chunk by chunk: the recording is built on its transpose, a
-        # column-major (N, 3) array, without another copy (see _build._rates_block)
+        # fill one (3, N) block: the recording is built on its transpose, a column-major (N, 3)
+        # array, without another copy (see _build._rates_block)
         block = np.empty((3, table.num_rows))
         for j, name in enumerate(rates):
-            pos = 0
-            for chunk in table.column(name).chunks:
-                block[j, pos:pos + len(chunk)] = chunk.to_numpy(zero_copy_only=False)
-                pos += len(chunk)
-            cols[name] = block[j]
-    return {n: cols[n] if n in cols else table.column(n).to_numpy() for n in names}
+            cols[name] = numeric_to_numpy(table.column(name), out=block[j])
+    for n in names:
+        column = table.column(n)
+        if n not in cols:
+            cols[n] = (numeric_to_numpy(column) if pa.types.is_floating(column.type)
+                       else text_to_numpy(column, dtype=str if n == mapping.get("axis") else object))
+    return cols
 
 
 def _read_python(path: Path, packed: str | None, layout: Layout, encoding: str) -> dict:

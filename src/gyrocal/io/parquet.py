@@ -25,7 +25,8 @@ def _as_float(column, name: str, source: str) -> np.ndarray:
         return pc.cast(column, pa.float64()).to_numpy(zero_copy_only=False)
     if pa.types.is_string(column.type) or pa.types.is_large_string(column.type):
         return to_float(column.to_numpy(zero_copy_only=False), name, source)
-    raise InputError(f"{source}: column {name!r} has type {column.type}, not numbers; map another column with --columns")
+    raise InputError(f"{source}: column {name!r} has type {column.type}, not numbers", param="columns",
+                     hint="map another column with {param}")
 
 
 def read_parquet_columns(path: str | os.PathLike, columns=None, *, accel: bool = False):

@@ -22,7 +22,8 @@ def _pick_topic(connections, topic: str | None, source: str) -> list:
         raise InputError(f"{source}: no sensor_msgs/Imu topic; topics found: {found}")
     if topic is None:
         if len(topics) > 1:
-            raise InputError(f"{source}: several Imu topics ({', '.join(topics)}); choose one with topic= (CLI --topic)")
+            raise InputError(f"{source}: several Imu topics ({', '.join(topics)})", param="topic",
+                             hint="choose one with {param}")
         return imu
     chosen = [c for c in imu if c.topic == topic]
     if not chosen:

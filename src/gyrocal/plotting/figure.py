@@ -8,7 +8,7 @@ from pathlib import Path
 from .._atomic import atomic_path
 from ..errors import InputError, MissingDependencyError
 
-__all__ = ["new_figure", "save_figure"]
+__all__ = ["check_figure_path", "new_figure", "save_figure"]
 
 _HINT = "plots need matplotlib: pip install 'gyrocal[plot]'"
 _FORMATS = ("png", "pdf", "svg")
@@ -34,11 +34,24 @@ def new_figure(figsize: tuple[float, float] = (11.0, 7.0), **kwargs):
     return fig
 
 
-def save_figure(fig, path: str | os.PathLike, dpi: int = 110) -> None:
-    """Write `fig` to `path` atomically; the format follows the suffix (png, pdf or svg)."""
+def check_figure_path(path: str | os.PathLike) -> str:
+    """The format of a figure path (png, pdf or svg), refusing other suffixes and unwritable folders.
+
+    Commands call it before writing any output, so a bad plot path fails before a JSON
+    file is written.
+    """
     fmt = Path(path).suffix.lower().lstrip(".")
     if fmt not in _FORMATS:
         got = Path(path).suffix or "no suffix"
         raise InputError(f"plot path {str(path)!r} must end in .png, .pdf or .svg, got {got!r}")
+    folder = next((p for p in Path(path).absolute().parents if p.exists()), None)
+    if folder is not None and not os.access(folder, os.W_OK | os.X_OK):
+        raise InputError(f"plot path {str(path)!r}: cannot write in {folder}; choose another folder")
+    return fmt
+
+
+def save_figure(fig, path: str | os.PathLike, dpi: int = 110) -> None:
+    """Write `fig` to `path` atomically; the format follows the suffix (png, pdf or svg)."""
+    fmt = check_figure_path(path)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format=fmt, dpi=dpi)

@@ -24,24 +24,13 @@ import numpy as np
 from .._validation import finite_array, positive
 from ..errors import InputError
 from ..observations import ObservationSet
+from ..windows import axis_vector
 
 __all__ = ["PAPER_AXES", "axis_vector", "paper_observations"]
 
 #: The paper's Fig. 1 order: +-x, +-y, +-z.
 PAPER_AXES: tuple[str, ...] = ("+x", "-x", "+y", "-y", "+z", "-z")
 _CHUNK_SAMPLES = 2_000_000  # samples x batch items drawn at once (~50 MB of float64 per array)
-
-
-def axis_vector(name: str) -> np.ndarray:
-    """Unit vector of a signed axis name such as ``"+x"`` or ``"-z"``."""
-    key = str(name).strip().lower()
-    if len(key) == 1:
-        key = "+" + key
-    if len(key) != 2 or key[0] not in "+-" or key[1] not in "xyz":
-        raise InputError(f"axis {name!r} is not one of +x, -x, +y, -y, +z, -z")
-    e = np.zeros(3)
-    e["xyz".index(key[1])] = 1.0 if key[0] == "+" else -1.0
-    return e
 
 
 def _tilted_axes(e: np.ndarray, misalignment: float, size: int, rng: np.random.Generator) -> np.ndarray:

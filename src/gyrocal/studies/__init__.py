@@ -9,8 +9,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import get_args
 
-from ..errors import InputError
 from ..choices import StudyName
+from ..errors import InputError
 from ._common import Progress, ServoSettings, StudyOutput
 
 __all__ = ["StudyName", "STUDY_NAMES", "run_study", "study_units", "StudyOutput", "ServoSettings"]

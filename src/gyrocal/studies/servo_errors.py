@@ -12,8 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..simulation.fast import simulate_observations
-from ._common import (METHOD_LABELS, PARAM_NAMES, Condition, Progress, ServoSettings, StudyOutput, draw_truth,
-                      fit_errors)
+from ._common import METHOD_LABELS, PARAM_NAMES, Condition, Progress, ServoSettings, StudyOutput, draw_truth, fit_errors
 from ._crb import crb_std
 from ._tables import write_table
 

@@ -17,8 +17,8 @@ import numpy as np
 
 from .._validation import positive
 from ..errors import InputError
-from ..saturation import find_saturation
 from ..recording import Recording
+from ..saturation import find_saturation
 from ._warn import DroppedStepsWarning, SaturatedStepsWarning
 
 __all__ = ["AXES", "Steps", "drop_saturated", "drop_unstable", "find_steps", "session_steps"]
@@ -255,7 +255,8 @@ def session_steps(recordings: Sequence[Recording], *, settle: float = 2.0, full_
     close = np.flatnonzero(np.diff(btemp[order]) <= tol)
     if close.size:
         a, b = order[close[0]], order[close[0] + 1]
-        src = lambda k: names[int(steps.source[block == k][0])]
+        def src(k):
+            return names[int(steps.source[block == k][0])]
         raise InputError(f"duplicate temperature point: {btemp[a]:.2f} degC ({src(a)}) and {btemp[b]:.2f} degC "
                          f"({src(b)}) are within temp_tolerance={tol:g} degC; keep one of them")
     if n_blocks < 3:

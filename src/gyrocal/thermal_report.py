@@ -1,4 +1,5 @@
-"""The evaluation report: CSV and Markdown tables and figures in one folder.
+"""The evaluation report of a thermal table (the full-temperature-range method): CSV and Markdown
+tables and figures in one folder. It writes files, so it lives outside the method package.
 
 Files written (units: the calibration's output unit unless told):
 
@@ -18,9 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .._atomic import write_text_atomic
-from .evaluate import METHODS, Evaluation, loto_comparison
-from .model import ThermalCalibration
+from ._atomic import write_text_atomic
+from .thermal.evaluate import METHODS, Evaluation, loto_comparison
+from .thermal.model import ThermalCalibration
 
 __all__ = ["markdown_table", "write_report"]
 
@@ -42,7 +43,7 @@ def markdown_table(rows: list[dict], columns: list[str] | None = None) -> str:
 
 
 def _write_rows(path: Path, rows: list[dict]) -> None:
-    from ..io import write_csv
+    from .io import write_csv
 
     if rows:
         write_csv(path, {k: np.array([r[k] for r in rows]) for k in rows[0]})
@@ -85,8 +86,8 @@ def write_report(cal: ThermalCalibration, evaluation: Evaluation, out_dir: str |
 
 
 def _figures(cal, evaluation, out: Path, unit: str, truth) -> list[Path]:
-    from ..plotting import save_figure
-    from ..plotting.thermal import plot_coefficients, plot_error_vs_rate, plot_error_vs_temperature
+    from .plotting import save_figure
+    from .plotting.thermal import plot_coefficients, plot_error_vs_rate, plot_error_vs_temperature
 
     paths = []
     for name, drawn in (("coefficients.png", plot_coefficients(cal, units=unit, truth=truth)),

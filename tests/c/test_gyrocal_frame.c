@@ -1,0 +1,109 @@
+/*
+ * Native tests of the frame encoder (gyrocal_frame.h) and the on-device session (gyrocal_session.h), built by
+ * tests/test_c_native.py with -fsanitize=address,undefined.
+ *
+ * References: the CRC-16/CCITT-FALSE check value 0x29B1 of "123456789" (the CRC catalogue's), a sample
+ * frame written out by hand from docs/capture.md's byte table, and a noise-free six-turn session built
+ * from a known k and b, which the session must find to float32 precision.
+ * Exit status: the number of failed checks (0 = all passed).
+ */
+#include "gyrocal_frame.h"
+#include "gyrocal_session.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+static int failures = 0;
+
+#define CHECK(cond)                                                                   \
+    do {                                                                              \
+        if (!(cond)) {                                                                \
+            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond);  \
+            ++failures;                                                               \
+        }                                                                             \
+    } while (0)
+
+static void test_crc_and_sample_frame(void)
+{
+    static const uint8_t check[9] = {'1', '2', '3', '4', '5', '6', '7', '8', '9'};
+    /* seq 1, t 5000 us, raw (1, -2, 300), temperature 25.00 degC */
+    static const uint8_t payload[16] = {1, 0, 0, 0, 0x88, 0x13, 0, 0, 1, 0, 0xFE, 0xFF, 0x2C, 0x01, 0xC4, 0x09};
+    const int16_t raw[3] = {1, -2, 300};
+    uint8_t out[GYROCAL_FRAME_MAX], head[2 + 16];
+    uint16_t crc;
+    CHECK(gyrocal_crc16(check, 9, 0xFFFFu) == 0x29B1u);
+    CHECK(gyrocal_frame_sample(out, 1u, 5000u, raw, 2500) == GYROCAL_FRAME_SAMPLE_SIZE);
+    CHECK(out[0] == 0xA5u && out[1] == 0x5Au && out[2] == GYROCAL_FRAME_SAMPLE && out[3] == 16u);
+    CHECK(memcmp(out + 4, payload, 16) == 0);
+    head[0] = GYROCAL_FRAME_SAMPLE;
+    head[1] = 16u;
+    memcpy(head + 2, payload, 16);
+    crc = gyrocal_crc16(head, sizeof head, 0xFFFFu);
+    CHECK(out[20] == (crc & 0xFFu) && out[21] == (crc >> 8));
+}
+
+static void test_null_and_limits(void)
+{
+    uint8_t out[GYROCAL_FRAME_MAX];
+    char longer[100];
+    memset(longer, 'a', sizeof longer - 1);
+    longer[sizeof longer - 1] = '\0';
+    CHECK(gyrocal_frame_sample(0, 0u, 0u, 0, 0) == 0u);
+    CHECK(gyrocal_frame_hello(out, 0) == 0u && gyrocal_frame_turn(out, 0) == 0u && gyrocal_frame_text(out, 0) == 0u);
+    CHECK(gyrocal_frame(out, 1u, out, GYROCAL_FRAME_MAX_PAYLOAD + 1u) == 0u);
+    CHECK(gyrocal_frame_text(out, longer) == GYROCAL_FRAME_MAX); /* cut at the payload limit, in bounds */
+    CHECK(gyrocal_frame_result(out, GYROCAL_E_SINGULAR, 0u, 0u, 6u, 0, 7u) == GYROCAL_FRAME_OVERHEAD + 32u);
+    CHECK(gyrocal_session_init(0, 200.0f, 131.0f, 360.0f) == GYROCAL_E_INPUT);
+    CHECK(gyrocal_session_add(0, 0) == 0u);
+}
+
+/* Noise-free readings [counts] of true rate w [deg/s] about one axis: raw = w / k - b. */
+static void reading(const float k[3], const float b[3], int axis, float w, int16_t raw[3])
+{
+    int i;
+    for (i = 0; i < 3; ++i) {
+        float c = (i == axis ? w : 0.0f) / k[i] - b[i];
+        raw[i] = (int16_t)(c < 0.0f ? c - 0.5f : c + 0.5f);
+    }
+}
+
+static void test_session_finds_the_six_turns(void)
+{
+    static gyrocal_session_t s;
+    const float k[3] = {1.0f / 131.0f, 1.02f / 131.0f, 0.98f / 131.0f}; /* deg/s per count */
+    const float b[3] = {200.0f, -150.0f, 80.0f};                        /* counts */
+    int16_t raw[3];
+    unsigned events, turns = 0u, results = 0u;
+    int turn, n;
+    CHECK(gyrocal_session_init(&s, 200.0f, 131.0f, 360.0f) == GYROCAL_OK);
+    for (n = 0; n < 400; ++n) { /* 2 s still */
+        reading(k, b, 0, 0.0f, raw);
+        gyrocal_session_add(&s, raw);
+    }
+    for (turn = 0; turn < 6; ++turn) {
+        for (n = 0; n < 1200 + 600; ++n) { /* 6 s at 60 deg/s: 360 deg, then 3 s still */
+            reading(k, b, turn / 2, n < 1200 ? ((turn % 2) ? -60.0f : 60.0f) : 0.0f, raw);
+            events = gyrocal_session_add(&s, raw);
+            if (events & GYROCAL_SESSION_TURN) {
+                ++turns;
+                CHECK(s.turn.status == GYROCAL_TURN_ACCEPTED && s.turn.slot == (uint8_t)turn);
+            }
+            results += (events & GYROCAL_SESSION_RESULT) ? 1u : 0u;
+        }
+    }
+    CHECK(turns == 6u && results == 1u && s.status == GYROCAL_OK);
+    /* rounding the readings to counts moves k by about 0.5 / 7860 at most */
+    for (n = 0; n < 3; ++n) {
+        CHECK(fabsf(s.result.k[n] / k[n] - 1.0f) < 2e-4f);
+        CHECK(fabsf(s.result.b[n] - b[n]) < 1.0f);
+    }
+}
+
+int main(void)
+{
+    test_crc_and_sample_frame();
+    test_null_and_limits();
+    test_session_finds_the_six_turns();
+    return failures;
+}

@@ -1,0 +1,154 @@
+"""Layers that read one way (CONTRACT.md section 1, docs/architecture.md): a forbidden import fails here.
+
+Reference: the source itself, parsed with ``ast`` (every import, at module level or inside a function),
+and, for the lazy command line, a fresh interpreter's ``sys.modules``.
+"""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import gyrocal
+
+SRC = Path(gyrocal.__file__).parent
+
+#: Component -> components it must never import (a component is a top-level module or subpackage of gyrocal).
+_FRONT = {"io", "cli", "plotting", "simulation", "studies", "export", "exporters", "thermal_report"}
+FORBIDDEN: dict[str, set[str]] = {
+    **{core: _FRONT | {"files", "firmware"}
+       for core in ("models", "observations", "estimators", "design", "segmentation", "windows", "recording",
+                    "units", "saturation", "planning", "noise", "stillness", "flight")},
+    # ThermalCalibration is a calibration kind: it registers with gyrocal.files and has c_header (firmware)
+    "thermal": _FRONT,
+    "simulation": {"io", "cli", "plotting", "studies", "thermal", "firmware", "export", "exporters"},
+    "plotting": {"cli", "io", "studies"},
+    "io": {"cli", "plotting", "simulation", "studies", "thermal"},
+    "studies": {"cli"},
+}
+#: Modules of gyrocal.cli that hold commands; each may import none of the others.
+CMDS_SUFFIX = "_cmds"
+#: Module-level imports a command module may make: ``gyrocal --help`` must not load numpy.
+LIGHT_FOR_CLI = ("gyrocal.choices", "gyrocal.errors", "gyrocal.export", "gyrocal.cli", "typer")
+
+
+def _module_name(path: Path) -> str:
+    rel = path.relative_to(SRC.parent).with_suffix("")
+    parts = list(rel.parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def _imports(path: Path) -> list[tuple[str, str | None, int, bool]]:
+    """(module imported, name imported or None, line, at module level) for every import in `path`."""
+    module = _module_name(path)
+    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+    tree = ast.parse(path.read_text(), filename=str(path))
+    top = {id(node) for node in tree.body}
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            out += [(a.name, None, node.lineno, id(node) in top) for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                anchor = package.split(".")
+                anchor = anchor[: len(anchor) - (node.level - 1)]
+                base = ".".join(anchor + ([base] if base else []))
+            for a in node.names:
+                full = f"{base}.{a.name}"
+                # "from . import x" may import a submodule x: count it as that module
+                is_module = (SRC.parent / Path(*full.split("."))).with_suffix(".py").exists() or (
+                    SRC.parent / Path(*full.split(".")) / "__init__.py").exists()
+                out.append((full, None, node.lineno, id(node) in top) if is_module
+                           else (base, a.name, node.lineno, id(node) in top))
+    return out
+
+
+def _component(module: str) -> str | None:
+    parts = module.split(".")
+    return parts[1] if parts[0] == "gyrocal" and len(parts) > 1 else None
+
+
+def _owner(module: str) -> str:
+    """Who may use a private part of `module`: its subpackage, or the module itself at the package root."""
+    parts = module.split(".")
+    if (SRC.parent / Path(*parts) / "__init__.py").exists() or len(parts) > 2:
+        return ".".join(parts[:2])
+    return module
+
+
+SOURCES = sorted(p for p in SRC.rglob("*.py"))
+
+
+def _problems() -> list[str]:
+    found = []
+    for path in SOURCES:
+        me = _module_name(path)
+        mine = _component(me)
+        for target, name, line, top in _imports(path):
+            where = f"{path.relative_to(SRC.parent)}:{line}"
+            theirs = _component(target)
+            if not target.startswith("gyrocal"):
+                if mine == "cli" and me.endswith(CMDS_SUFFIX) and top and target.split(".")[0] in (
+                        "numpy", "scipy", "rich", "matplotlib", "pyarrow"):
+                    found.append(f"{where}: command module imports {target} at module level (lazy imports only)")
+                continue
+            if theirs in FORBIDDEN.get(mine, ()):
+                found.append(f"{where}: {mine} must not import {target}")
+            if theirs == "cli" and mine not in ("cli", "__main__"):
+                found.append(f"{where}: the library must not import the command line ({target})")
+            if target == "gyrocal" and name is not None and me != "gyrocal":
+                found.append(f"{where}: import from the package root ({name}); import the defining module")
+            parts = target.split(".")
+            private_at = next((i for i, part in enumerate(parts) if i >= 2 and part.startswith("_")
+                               and not part.startswith("__")), None)
+            if private_at is not None:
+                owner = ".".join(parts[:private_at])
+                if not (me == owner or me.startswith(owner + ".")):
+                    found.append(f"{where}: {target} is private to {owner}")
+            if name is not None and name.startswith("_") and not name.startswith("__"):
+                owner = _owner(target)
+                if not (me == owner or me.startswith(owner + ".")):
+                    found.append(f"{where}: {target}.{name} is private to {owner}")
+            if mine == "cli" and me.endswith(CMDS_SUFFIX) and target.startswith("gyrocal.cli.") and \
+                    target.endswith(CMDS_SUFFIX) and target != me:
+                found.append(f"{where}: command modules never import each other ({target})")
+            if mine == "cli" and me.endswith(CMDS_SUFFIX) and top and not target.startswith(LIGHT_FOR_CLI):
+                found.append(f"{where}: command module imports {target} at module level (lazy imports only)")
+    return found
+
+
+def test_no_forbidden_import():
+    problems = _problems()
+    assert not problems, "\n".join(problems)
+
+
+@pytest.mark.parametrize("bad, message", [
+    ("from ..io import read_recording\n", "thermal must not import gyrocal.io"),
+    ("from ..models import _KG_ROWS\n", "gyrocal.models._KG_ROWS is private"),
+    ("from ..segmentation._motion import static_level\n", "gyrocal.segmentation._motion is private"),
+    ("from ..cli import app\n", "must not import the command line"),
+])
+def test_the_check_catches_what_it_forbids(tmp_path, monkeypatch, bad, message):
+    """The checker itself, on a planted module inside gyrocal/thermal (removed afterwards)."""
+    planted = SRC / "thermal" / "_planted_for_test.py"
+    planted.write_text(bad)
+    try:
+        monkeypatch.setattr(sys.modules[__name__], "SOURCES", [planted])
+        problems = _problems()
+    finally:
+        planted.unlink()
+    assert any(message in p for p in problems), problems
+
+
+def test_the_command_line_starts_without_numpy():
+    code = ("import sys, gyrocal.cli; heavy = sorted(m for m in ('numpy', 'scipy', 'matplotlib', 'pyarrow', "
+            "'pydantic') if m in sys.modules); print(','.join(heavy))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True)
+    assert out.stdout.strip() == ""
