@@ -80,9 +80,9 @@ def main() -> None:
         run = calibrate(rec, **ref)
         plain, estimate, checked = math.inf, math.inf, math.inf
         for _ in range(args.repeat):  # alternate, so that the machine's load hits all alike
-            plain = min(plain, cpu_time(lambda: calibrate(rec, checks=False, long_run=False, **ref)))
-            estimate = min(estimate, cpu_time(lambda: calibrate(rec, checks=False, **ref)))
-            checked = min(checked, cpu_time(lambda: calibrate(rec, **ref)))
+            plain = min(plain, cpu_time(lambda ref=ref: calibrate(rec, checks=False, long_run=False, **ref)))
+            estimate = min(estimate, cpu_time(lambda ref=ref: calibrate(rec, checks=False, **ref)))
+            checked = min(checked, cpu_time(lambda ref=ref: calibrate(rec, **ref)))
         extra = checked - estimate
         print(f"{name} ({len(run.observations)} windows): calibrate {estimate:.3f} s without the self-checks, "
               f"{checked:.3f} s with them: the self-checks cost {100 * extra / estimate:.1f} % of the calibration "

@@ -58,6 +58,8 @@ FLAGS: dict[str, str] = {
     "quantum": "--quantum",
     "bias_instability": "--bias-instability",
     "rate_random_walk": "--rrw",
+    "stamps": "--stamps",
+    "gaps": "--gaps",
     # noise, thermal-bias, flight and VIO exports
     "imu": "--imu",
     "motion": "--motion",

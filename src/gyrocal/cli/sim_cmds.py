@@ -115,7 +115,7 @@ def simulate(
     = None,
     revolutions: Annotated[Optional[str], typer.Option(
         "--revolutions", help="Servo/hand: revolutions of each turn, one number or one per turn (0.375,0.5,0.75 = "
-                              "135, 180, 270 deg).")] = None,
+                              "135, 180, 270 deg). Default: 1.")] = None,
     ripple: Annotated[float, typer.Option(
         "--ripple", help="Servo: sinusoidal speed ripple, amplitude as a fraction of the speed (0.05 = 5 %).")] = 0.0,
     ripple_freq: Annotated[float, typer.Option("--ripple-freq", help="Servo: frequency of the ripple [Hz].")] = 2.5,
@@ -203,12 +203,8 @@ def simulate(
         ref_rec, facts["reference"] = _reference_log(rec.t, true_rates, reference, rng, sample_rate=ref_sample_rate,
                                                      offset=ref_offset, drift=ref_drift, mounting=ref_mounting,
                                                      noise=ref_noise)
-    if stamps == "receive" or gaps:
-        if reference is not None:
-            raise InputError("--reference is written on the true clock; give it or --stamps receive/--gaps, not both")
-        rec, facts = _time_defects(rec, facts, settings, stamps, late_per_minute, gaps, gap_length, rng)
-    elif given(ctx, "late_per_minute"):
-        raise InputError("--late-per-minute is for --stamps receive; add it or leave --late-per-minute out")
+    if stamps == "receive" or gaps or given(ctx, "late_per_minute"):
+        rec, facts = _time_defects(rec, facts, settings, stamps, late_per_minute, gaps, gap_length, reference, rng)
     write_recording(output, rec, units=unit,
                     header_comment=f"{_SIMULATED} --protocol {protocol}; gyro in {unit}, t in s")
     if ref_rec is not None:
@@ -265,24 +261,18 @@ def _reference_log(t, true_rates, path: Path, rng, *, sample_rate: float, offset
     return rec, {"path": path.name, **truth.to_dict()}
 
 
-def _time_defects(rec, facts: dict, settings: dict, stamps: str, late_per_minute: float, gaps: int,
-                  gap_length: float, rng):
-    """Receive-time stamps and packet gaps on a simulated recording; truth windows moved to its rows."""
-    from ..simulation.timestamps import ReceiveClock, rows_after_gaps, with_time_defects
+def _time_defects(rec, facts, settings, stamps, late_per_minute, gaps, gap_length, reference, rng):
+    """Receive-time stamps and packet gaps (:func:`gyrocal.simulation.timestamps.simulate_time_defects`)."""
+    from ..simulation.timestamps import simulate_time_defects
 
-    if gaps < 0 or not gap_length > 0:
-        raise InputError(f"--gaps must be >= 0 and --gap-length > 0 s, got {gaps} and {gap_length:g}")
-    clock = ReceiveClock(late_per_minute=late_per_minute) if stamps == "receive" else None
-    out, truth = with_time_defects(rec, rng, clock=clock, gaps=gaps, gap_length=gap_length)
-    settings.update(stamps=stamps, late_per_minute=late_per_minute, gaps=gaps, gap_length_s=gap_length)
-    moved = dict(facts)
-    for key in ("windows", "plateaus"):
-        if key in moved:
-            moved[key] = [{**w, "start": int(rows_after_gaps(w["start"], truth["gaps"])),
-                           "stop": int(rows_after_gaps(w["stop"], truth["gaps"]))} for w in moved[key]]
-    moved["time_base"] = {**truth, "note": "gaps: [first missing sample of the sensor clock, count]; windows and "
-                                           "plateaus are rows of the recording"}
-    return out, moved
+    if stamps != "receive" and late_per_minute:
+        raise InputError("--late-per-minute is for --stamps receive; add it or leave --late-per-minute out")
+    if reference is not None:
+        raise InputError("--reference is written on the true clock; give it or --stamps receive/--gaps, not both")
+    rec, facts, more = simulate_time_defects(rec, facts, rng, stamps=stamps, late_per_minute=late_per_minute,
+                                             gaps=gaps, gap_length=gap_length)
+    settings.update(more)
+    return rec, facts
 
 
 def _serve_device(protocol, speed, turns, wait, misalignment, k, b, noise, noise_density, sample_rate, seed, wire,
