@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -220,3 +221,33 @@ def test_units_show_their_choices():
         assert code == 0 and "--units <rad/s|deg/s|counts>" in out, command
     code, out, _ = invoke("calibrate", "--help")
     assert "(required)" in " ".join(out.split())
+
+
+# ---------------------------------------------------------------- what was found instead of the turns
+
+
+def test_no_rotation_says_what_was_measured_and_the_likely_fix(session, tmp_path):
+    """Reference: the session's turns are 360 deg at 60 deg/s, 200 Hz, in deg/s (as simulated)."""
+    cases = [
+        (("rad.csv", "--units", "deg/s", "--angle", "360", "--no-unit-check"),
+         "are the data in rad/s? (--units rad/s)"),
+        (("rad.csv", "--units", "deg/s", "--speed", "60", "--no-unit-check"), "are the data in rad/s? (--units rad/s)"),
+        (("deg.csv", "--units", "deg/s", "--angle", "36"), "were the turns 360 deg (--angle 360)?"),
+        # the raw plateau level is k times the speed: 60 deg/s reads 59.5-60.3
+        (("deg.csv", "--units", "deg/s", "--speed", "6"), re.compile(r"was the speed 60(\.\d)? deg/s \(--speed 60")),
+    ]
+    for args, fix in cases:
+        line = refused("calibrate", session / args[0], *args[1:])
+        assert "the turns left out measure +x" in line and "most likely: every" in line, line
+        assert (fix.search(line) if isinstance(fix, re.Pattern) else fix in line), line
+    # a wrong sample rate on a log without a time column: the rate that explains the turns is named
+    lines = (session / "deg.csv").read_text().splitlines()
+    bare = tmp_path / "g.csv"
+    bare.write_text("gx,gy,gz\n" + "\n".join(line.split(",", 1)[1] for line in lines[2:]) + "\n")
+    line = refused("calibrate", bare, "--units", "deg/s", "--sample-rate", "1000")
+    assert re.search(r"is the sample rate 20\d Hz \(--sample-rate 20\d\)\?", line), line
+    # turns about two axes only
+    code, _, err = invoke("simulate", "-o", tmp_path / "two.csv", "--turns", "+x,-x,+y,-y")
+    assert code == 0, err
+    line = refused("calibrate", tmp_path / "two.csv", "--units", "deg/s")
+    assert "no rotation about z" in line and "turn about the missing axes too" in line

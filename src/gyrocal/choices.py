@@ -28,6 +28,7 @@ __all__ = [
     "SaturationPolicy",
     "StudyName",
     "TableModel",
+    "TimeStamps",
     "values",
 ]
 
@@ -49,6 +50,8 @@ TableModel = Literal["lagrange", "smooth", "traditional"]
 Protocol = Literal["servo", "hand", "turntable", "profile", "static", "multi-position"]
 #: What a noise analysis does with a log that moves: analyse its longest still stretch, or refuse it.
 MotionPolicy = Literal["restrict", "refuse"]
+#: How ``gyrocal simulate`` stamps its samples: on the sensor's clock, or as a PC receiving packets.
+TimeStamps = Literal["sensor", "receive"]
 #: Monte Carlo studies reproducing the papers (see :mod:`gyrocal.studies`).
 StudyName = Literal["servo-normal", "servo-extreme", "servo-speed", "servo-convergence", "thermal-compare"]
 #: Wire formats ``gyrocal capture`` reads ("auto": whichever decodes first; see :mod:`gyrocal.capture`).

@@ -176,8 +176,10 @@ class Section(Mapping):
 def _residuals(v):
     """Residuals in noise units: numbers, or one ``{"window", "label", "z": [numbers]}`` object per window."""
     if isinstance(v, tuple) and all(isinstance(r, Mapping) for r in v):
-        for r in v:
-            numbers((-1,))(r.get("z", ()))
+        for r in v:  # plain Python: thousands of windows, a few numbers each
+            z = r.get("z", ())
+            if not isinstance(z, tuple) or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in z):
+                raise ValueError(f"must hold numbers 'z' in every window, got {_thaw(z)!r}")
         return v
     return numbers((-1,))(v)
 

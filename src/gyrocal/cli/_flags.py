@@ -68,6 +68,8 @@ FLAGS: dict[str, str] = {
     "poses": "--poses",
     "turn_deg": "--tilt",
     "static_duration": "--still",
+    "stamps": "--stamps",
+    "gaps": "--gaps",
     # noise, thermal-bias, flight and VIO exports
     "imu": "--imu",
     "motion": "--motion",
@@ -101,6 +103,7 @@ FLAGS: dict[str, str] = {
     "ref_noise_std": "--ref-noise",
     "ref_units": "--ref-units",
     "ref_columns": "--ref-columns",
+    "ref_skip_rows": "--ref-skip-rows",
     "ref_sample_rate": "--ref-sample-rate",
     "ref_sensitivity": "--ref-sensitivity",
     "ref_topic": "--ref-topic",

@@ -12,7 +12,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from ..choices import DeviceWire, Protocol
+from ..choices import DeviceWire, Protocol, TimeStamps
 from ..errors import InputError
 from ._options import NoiseDensity, given, noise_std, numbers, refuse_unused, triple
 from ._outputs import check_output, json_format, starts_with
@@ -24,7 +24,8 @@ _SIMULATED = "gyrocal simulate"  # first words of a simulated recording: a later
 _SERVO = ("servo", "hand")
 #: Flags that only some protocols use; the rest apply to every protocol.
 _PROTOCOL_FLAGS = {
-    **dict.fromkeys(("speed", "turns", "wait", "ramp"), _SERVO), "vibration": ("servo",),
+    **dict.fromkeys(("speed", "turns", "wait", "ramp", "revolutions"), _SERVO),
+    **dict.fromkeys(("vibration", "ripple", "ripple_freq"), ("servo",)),
     "misalignment": (*_SERVO, "multi-position"),
     # the turntable gyro follows the full-temperature-range method's thermal truth
     **dict.fromkeys(("k", "b"), (*_SERVO, "profile", "multi-position")),
@@ -121,6 +122,20 @@ def simulate(
     temp_quantum: Annotated[Optional[float], typer.Option(
         "--temp-quantum", help="--protocol turntable, static: resolution of the temperature readings [degC], e.g. 1 (default: none, not quantised).")]
     = None,
+    revolutions: Annotated[Optional[str], typer.Option(
+        "--revolutions", help="Servo/hand: revolutions of each turn, one number or one per turn (0.375,0.5,0.75 = "
+                              "135, 180, 270 deg). Default: 1.")] = None,
+    ripple: Annotated[float, typer.Option(
+        "--ripple", help="Servo: sinusoidal speed ripple, amplitude as a fraction of the speed (0.05 = 5 %).")] = 0.0,
+    ripple_freq: Annotated[float, typer.Option("--ripple-freq", help="Servo: frequency of the ripple [Hz].")] = 2.5,
+    stamps: Annotated[TimeStamps, typer.Option(
+        "--stamps", help="Time stamps: the sensor's clock, or receive times of a PC reading packets of two samples "
+                         "(steps of about 3 and 17 ms at 100 Hz).")] = "sensor",
+    late_per_minute: Annotated[float, typer.Option(
+        "--late-per-minute", help="--stamps receive: late packets per minute (a long step caught up by a burst; "
+                                  "nothing lost).")] = 0.0,
+    gaps: Annotated[int, typer.Option("--gaps", help="Packet gaps: runs of samples never delivered.")] = 0,
+    gap_length: Annotated[float, typer.Option("--gap-length", help="Length of each gap [s].")] = 0.17,
     sample_rate: Annotated[float, typer.Option("--sample-rate", help="Sampling rate [Hz].")] = 200.0,
     units: Annotated[str, typer.Option("--units", help="Unit of the written gyro columns.")] = "deg/s",
     seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
@@ -183,7 +198,8 @@ def simulate(
                 "seed": seed, "units": unit}
     if protocol in _SERVO:
         rec, facts, true_rates = _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misalignment,
-                                        sample_rate, rng, settings)
+                                        sample_rate, rng, settings, revolutions=revolutions, ripple=ripple,
+                                        ripple_freq=ripple_freq)
     elif protocol == "multi-position":
         density = 0.002 if accel_noise_density is None else accel_noise_density
         rec, model, facts = _multi_position(model, gyro_kw, poses, tilt, still, density * math.sqrt(sample_rate),
@@ -201,6 +217,8 @@ def simulate(
         ref_rec, facts["reference"] = _reference_log(rec.t, true_rates, reference, rng, sample_rate=ref_sample_rate,
                                                      offset=ref_offset, drift=ref_drift, mounting=ref_mounting,
                                                      noise=ref_noise)
+    if stamps == "receive" or gaps or given(ctx, "late_per_minute"):
+        rec, facts = _time_defects(rec, facts, settings, stamps, late_per_minute, gaps, gap_length, reference, rng)
     write_recording(output, rec, units=unit,
                     header_comment=f"{_SIMULATED} --protocol {protocol}; gyro in {unit}, t in s")
     if ref_rec is not None:
@@ -257,6 +275,20 @@ def _reference_log(t, true_rates, path: Path, rng, *, sample_rate: float, offset
     return rec, {"path": path.name, **truth.to_dict()}
 
 
+def _time_defects(rec, facts, settings, stamps, late_per_minute, gaps, gap_length, reference, rng):
+    """Receive-time stamps and packet gaps (:func:`gyrocal.simulation.timestamps.simulate_time_defects`)."""
+    from ..simulation.timestamps import simulate_time_defects
+
+    if stamps != "receive" and late_per_minute:
+        raise InputError("--late-per-minute is for --stamps receive; add it or leave --late-per-minute out")
+    if reference is not None:
+        raise InputError("--reference is written on the true clock; give it or --stamps receive/--gaps, not both")
+    rec, facts, more = simulate_time_defects(rec, facts, rng, stamps=stamps, late_per_minute=late_per_minute,
+                                             gaps=gaps, gap_length=gap_length)
+    settings.update(more)
+    return rec, facts
+
+
 def _serve_device(protocol, speed, turns, wait, misalignment, k, b, noise, noise_density, sample_rate, seed, wire,
                   faults, pace) -> None:
     """``simulate --device``: a simulated session served on a pseudo-terminal until it is read to the end."""
@@ -292,19 +324,23 @@ def _serve_device(protocol, speed, turns, wait, misalignment, k, b, noise, noise
     console.print(f"sent {dev.sent:,} bytes; the device closed the link", highlight=False)
 
 
-def _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misalignment, sample_rate, rng, settings):
+def _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misalignment, sample_rate, rng, settings,
+           *, revolutions: str | None = None, ripple: float = 0.0, ripple_freq: float = 2.5):
     """A servo or hand session: the recording, its facts and true rates; `settings` gains the protocol's."""
     from ..simulation import VirtualGyro
     from ..simulation.servo import ServoProtocol, simulate_servo
     from ..simulation.truth import servo_facts
 
     turn_list = tuple(t.strip() for t in turns.split(",") if t.strip())
-    kw = dict(speed=math.radians(speed), wait=wait, ramp=ramp, misalignment_deg=misalignment)
+    revs = (1.0,) if revolutions is None else tuple(numbers("--revolutions", revolutions))
+    kw = dict(speed=math.radians(speed), wait=wait, ramp=ramp, misalignment_deg=misalignment,
+              revolutions=revs[0] if len(revs) == 1 else revs)
     proto = (ServoProtocol.hand(turn_list, **kw) if protocol == "hand"
-             else ServoProtocol(turns=turn_list, vibration=vibration, **kw))
+             else ServoProtocol(turns=turn_list, vibration=vibration, ripple=ripple, ripple_freq=ripple_freq, **kw))
     rec, truth = simulate_servo(VirtualGyro(model, **gyro_kw), proto, sample_rate=sample_rate, rng=rng)
     settings.update(speed_deg_s=speed, turns=list(turn_list), wait_s=wait, ramp_s=ramp, vibration=vibration,
-                    misalignment_deg=misalignment)
+                    misalignment_deg=misalignment, revolutions=[float(r) for r in proto.turn_angles() / (2 * math.pi)],
+                    ripple=ripple, ripple_freq_hz=ripple_freq)
     return rec, servo_facts(truth), truth.rates
 
 
