@@ -149,7 +149,7 @@ def imu(
     gravity: READING.Gravity = 9.80665,
     windows: Annotated[Optional[Path], typer.Option(
         "--windows", help="Still poses (and turns) chosen by hand; imucal's section list makes a Ferraris "
-        "session.")] = None,
+        "session (default: none, the poses are detected).")] = None,
     accel_model: Annotated[AccelModel, typer.Option(
         "--accel-model", help="Accelerometer model; auto: the largest the poses determine.")] = "auto",
     gyro_model: Annotated[ImuGyroModel, typer.Option(
@@ -161,9 +161,11 @@ def imu(
         "--min-static", help="Shortest still pose kept [s].")] = 1.0,
     accel_output_units: Annotated[AccelOutputUnit, typer.Option(
         "--accel-output-units", help="Unit of corrected accelerations.")] = "m/s^2",
-    output: Annotated[Optional[Path], typer.Option("-o", "--output", help="Calibration file to write.")] = None,
+    output: Annotated[Optional[Path], typer.Option(
+        "-o", "--output", help="Calibration file to write (default: none, print only).")] = None,
     plot: Annotated[Optional[Path], typer.Option(
-        "--plot", help="Picture of the poses on the sphere and each turn's misfit (.png, .pdf, .svg).")] = None,
+        "--plot", help="Picture of the poses on the sphere and each turn's misfit (.png, .pdf, .svg) "
+        "(default: none).")] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace an output that holds another calibration.")]
     = False,
 ) -> None:

@@ -16,6 +16,7 @@ from ..choices import DeviceWire, Protocol, TimeStamps
 from ..errors import InputError
 from ._options import NoiseDensity, given, noise_std, numbers, refuse_unused, triple
 from ._outputs import check_output, json_format, starts_with
+from ._sim_runs import multi_position, profile_run, turntable, turntable_protocol
 from .app import app, console
 
 __all__ = ["simulate"]
@@ -41,21 +42,6 @@ _PROTOCOL_FLAGS = {
 }
 #: Flags that describe the reference log, so they need --reference.
 _REFERENCE_FLAGS = ("ref_sample_rate", "ref_offset", "ref_drift", "ref_mounting", "ref_noise", "ref_units")
-
-
-def _turntable_protocol(temps: str | None, rates: str | None, step_duration: float | None, temp_noise: float,
-                        temp_quantum: float | None):
-    """The full-temperature-range method's protocol; unset flags keep the paper's values."""
-    from ..simulation.turntable import TurntableProtocol
-
-    kw: dict = {}
-    if temps is not None:
-        kw["temps"] = tuple(numbers("--temps", temps))
-    if rates is not None:
-        kw["rates"] = tuple(numbers("--rates", rates))
-    if step_duration is not None:
-        kw["step_duration"] = step_duration
-    return TurntableProtocol(**kw, temp_noise=temp_noise, temp_quantum=temp_quantum)
 
 
 @app.command()
@@ -201,16 +187,14 @@ def simulate(
                                         sample_rate, rng, settings, revolutions=revolutions, ripple=ripple,
                                         ripple_freq=ripple_freq)
     elif protocol == "multi-position":
-        density = 0.002 if accel_noise_density is None else accel_noise_density
-        rec, model, facts = _multi_position(model, gyro_kw, poses, tilt, still, density * math.sqrt(sample_rate),
-                                            misalignment, sample_rate, rng, settings)
+        rec, model, facts = multi_position(model, gyro_kw, ctx.params, sample_rate, rng, settings)
     elif protocol == "turntable":
-        rec, model, facts = _turntable(gyro_kw, _turntable_protocol(temps, rates, step_duration, temp_noise,
+        rec, model, facts = turntable(gyro_kw, turntable_protocol(temps, rates, step_duration, temp_noise,
                                                                      temp_quantum), sample_rate, rng, settings)
     elif protocol == "static":
         rec, facts = _static(gyro_kw, ctx.params, sample_rate, rng, settings)
     else:
-        rec, facts, true_rates = _profile(model, gyro_kw, profile, profile_units, duration, sample_rate, rng,
+        rec, facts, true_rates = profile_run(model, gyro_kw, profile, profile_units, duration, sample_rate, rng,
                                           settings)
     ref_rec = None
     if reference is not None:
@@ -342,63 +326,6 @@ def _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misali
                     misalignment_deg=misalignment, revolutions=[float(r) for r in proto.turn_angles() / (2 * math.pi)],
                     ripple=ripple, ripple_freq_hz=ripple_freq)
     return rec, servo_facts(truth), truth.rates
-
-
-def _multi_position(model, gyro_kw, poses, tilt, still, accel_noise, misalignment, sample_rate, rng, settings):
-    """A hand multi-position session of a whole IMU: the recording (with ax, ay, az), gyro model, facts."""
-    from ..simulation import VirtualGyro
-    from ..simulation.multiposition import (
-        MultiPositionProtocol,
-        VirtualImu,
-        mounted_gyro,
-        random_accelerometer,
-        session_facts,
-        session_recording,
-        simulate_multi_position,
-    )
-
-    gyro = mounted_gyro(model, misalignment, rng)
-    a, o = random_accelerometer(rng)
-    imu = VirtualImu(VirtualGyro(gyro, **gyro_kw), accel_matrix=a, accel_offset=o, accel_noise_std=accel_noise)
-    proto = MultiPositionProtocol(poses=poses, turn_deg=tilt, static_duration=(0.75 * still, 1.25 * still),
-                                  sample_rate=sample_rate)
-    session = simulate_multi_position(imu, proto, rng=rng)
-    settings.update(poses=poses, tilt_deg=tilt, still_s=still, accel_noise_std=accel_noise,
-                    misalignment_deg=misalignment)
-    return session_recording(session), gyro, session_facts(session)
-
-
-def _turntable(gyro_kw, proto, sample_rate, rng, settings):
-    """A turntable session of a gyro following the thermal truth: recording, model at 25 degC, facts."""
-    import numpy as np
-
-    from ..models import Affine
-    from ..simulation import VirtualGyro
-    from ..simulation.thermal_truth import ThermalTruth
-    from ..simulation.turntable import simulate_turntable
-
-    thermal = ThermalTruth()
-    K, B = thermal(np.array([thermal.ref_temp]))
-    model = Affine(K[0], B[0])
-    rec = simulate_turntable(VirtualGyro(model, thermal=thermal, **gyro_kw), proto, sample_rate=sample_rate, rng=rng)
-    settings.update(temps_degC=list(proto.temps), rates_deg_s=list(proto.rates), axes=list(proto.axes),
-                    step_duration_s=proto.step_duration, table_tau_s=proto.table_tau,
-                    temp_noise_degC=proto.temp_noise, temp_quantum_degC=proto.temp_quantum)
-    return rec, model, {"thermal": thermal.to_dict()}
-
-
-def _profile(model, gyro_kw, profile, profile_units, duration, sample_rate, rng, settings):
-    """A recording of a rate profile read from a CSV file."""
-    from ..io import read_profile
-    from ..simulation import VirtualGyro
-    from ..simulation.profiles import simulate_profile
-
-    if profile is None or duration is None:
-        raise InputError("--protocol profile needs --profile FILE.csv and --duration SECONDS")
-    rec, true_rates = simulate_profile(VirtualGyro(model, **gyro_kw), read_profile(profile, units=profile_units),
-                                       duration=duration, sample_rate=sample_rate, rng=rng)
-    settings.update(profile=str(profile), duration_s=duration)
-    return rec, {}, true_rates
 
 
 def _static(gyro_kw, flags: dict, sample_rate, rng, settings):

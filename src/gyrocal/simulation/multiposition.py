@@ -26,7 +26,7 @@ from ..imu import quaternion as quat
 from ..imu.gyro import EARTH_RATE
 from .gyro import VirtualGyro
 
-__all__ = ["ImuSession", "MultiPositionProtocol", "VirtualImu", "mounted_gyro", "random_accelerometer",
+__all__ = ["ImuSession", "MultiPositionProtocol", "VirtualImu", "hand_session", "mounted_gyro", "random_accelerometer",
            "session_facts", "session_recording", "simulate_multi_position"]
 
 
@@ -303,3 +303,30 @@ def session_facts(session: ImuSession) -> dict:
                                 "units": "rad/s", "equation": "w_true = matrix @ (raw - offset - G a_true)"},
             "g_sensitivity": tr["g_sensitivity"].tolist(), "gravity": tr["gravity"],
             "poses": session.orientations.tolist(), "still": session.still.tolist()}
+
+
+def hand_session(gyro_model, *, gyro_kw: dict, poses: int = 24, tilt_deg: float = 90.0, still: float = 3.0,
+                 accel_noise_std: float = 0.02, misalignment_deg: float = 5.0, sample_rate: float = 100.0,
+                 rng: np.random.Generator):
+    """The whole-IMU session of ``gyrocal simulate --protocol multi-position``.
+
+    The gyro (`gyro_model` and :class:`VirtualGyro` options `gyro_kw`) is mounted `misalignment_deg`
+    off a drawn accelerometer (:func:`random_accelerometer`); `poses` poses a tilt of `tilt_deg`
+    apart, each still for ``still`` s +- 25 %.
+
+    Returns
+    -------
+    (Recording, Affine, dict, dict)
+        The recording, the gyro's true model, the truth facts, the settings.
+    """
+    from .gyro import VirtualGyro
+
+    gyro = mounted_gyro(gyro_model, misalignment_deg, rng)
+    a, o = random_accelerometer(rng)
+    imu = VirtualImu(VirtualGyro(gyro, **gyro_kw), accel_matrix=a, accel_offset=o, accel_noise_std=accel_noise_std)
+    proto = MultiPositionProtocol(poses=poses, turn_deg=tilt_deg, static_duration=(0.75 * still, 1.25 * still),
+                                  sample_rate=sample_rate)
+    session = simulate_multi_position(imu, proto, rng=rng)
+    settings = {"poses": poses, "tilt_deg": tilt_deg, "still_s": still, "accel_noise_std": accel_noise_std,
+                "misalignment_deg": misalignment_deg}
+    return session_recording(session), gyro, session_facts(session), settings
