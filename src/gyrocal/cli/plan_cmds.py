@@ -7,9 +7,9 @@ from typing import Annotated, Optional
 
 import typer
 
-from ..choices import DesignName
+from ..choices import PlanDesign
 from ..errors import InputError
-from ._options import NoiseDensity, noise_std, triple
+from ._options import NoiseDensity, noise_std, refuse_unused, triple
 from .app import app, console
 
 __all__ = ["plan"]
@@ -35,12 +35,22 @@ def _rate_arg(name: str, text: str | None, default_unit: str) -> float | None:
     return value
 
 
+#: Flags of one kind of design only (the rest apply to both).
+_DESIGN_FLAGS = {
+    **dict.fromkeys(("speed", "revolutions", "k", "wait", "max_speed"), ("six", "six-static", "twelve")),
+    **dict.fromkeys(("poses", "tilt", "still", "peak_rate", "accel_noise_density", "target_cross",
+                     "target_accel_scale", "target_accel_offset"), ("poses",)),
+}
+
+
 @app.command()
 def plan(
+    ctx: typer.Context,
     speed: Annotated[float, typer.Option("--speed", help="Turn speed [deg/s].")] = 60.0,
     revolutions: Annotated[float, typer.Option("--revolutions", help="Revolutions per turn.")] = 1.0,
-    design: Annotated[DesignName, typer.Option(
-        "--design", help="six (the servo method of Wang et al., Fig. 1), six-static, twelve.")] = "six",
+    design: Annotated[PlanDesign, typer.Option(
+        "--design", help="six (the servo method of Wang et al., Fig. 1), six-static, twelve; poses: a hand session "
+        "of still poses for 'gyrocal imu'.")] = "six",
     sample_rate: Annotated[float, typer.Option("--sample-rate", help="Sampling rate [Hz].")] = 200.0,
     noise: Annotated[Optional[float], typer.Option(
         "--noise", help="Per-sample white noise [rad/s] (default: 0.035, the paper's simulations).")] = None,
@@ -56,11 +66,38 @@ def plan(
         "--target-bias", help="Target std of every bias, e.g. 0.01deg/s (unit rad/s if none given) (default: "
         "none; no suggestion).")] = None,
     max_speed: Annotated[float, typer.Option("--max-speed", help="Fastest speed to consider [deg/s].")] = 180.0,
+    poses: Annotated[int, typer.Option("--poses", help="--design poses: still poses.")] = 24,
+    tilt: Annotated[float, typer.Option("--tilt", help="--design poses: tilt between successive poses [deg].")]
+    = 90.0,
+    still: Annotated[float, typer.Option("--still", help="--design poses: still time per pose [s].")] = 2.0,
+    peak_rate: Annotated[float, typer.Option(
+        "--peak-rate", help="--design poses: peak rate of each hand move [deg/s].")] = 150.0,
+    accel_noise_density: Annotated[float, typer.Option(
+        "--accel-noise-density", help="--design poses: accelerometer noise density [m/s^2/sqrt(Hz)] (MPU-6050: "
+        "about 0.004).")] = 0.002,
+    target_cross: Annotated[Optional[float], typer.Option(
+        "--target-cross", help="--design poses: target std of every cross term (misalignment) of both sensors [-] "
+        "(default: none).")] = None,
+    target_accel_scale: Annotated[Optional[float], typer.Option(
+        "--target-accel-scale", help="--design poses: target std of the accelerometer's scale factors [-] "
+        "(default: none).")] = None,
+    target_accel_offset: Annotated[Optional[float], typer.Option(
+        "--target-accel-offset", help="--design poses: target std of the accelerometer's offsets [m/s^2] "
+        "(default: none).")] = None,
 ) -> None:
     """Predict each parameter's std and the protocol time; suggest the fastest protocol for a target."""
     import numpy as np
     from rich.markup import escape
     from rich.table import Table
+
+    refuse_unused(ctx, _DESIGN_FLAGS, design, "--design")
+    if design == "poses":
+        targets = {"gyro_scale": target_scale, "gyro_bias": _rate_arg("--target-bias", target_bias, "rad/s"),
+                   "gyro_cross": target_cross, "accel_cross": target_cross, "accel_scale": target_accel_scale,
+                   "accel_offset": target_accel_offset}
+        density = noise_std(noise, noise_density, sample_rate, 0.0017) / math.sqrt(sample_rate)
+        return _plan_poses(poses, tilt, still, peak_rate, sample_rate, accel_noise_density, float(np.mean(density)),
+                           {k: v for k, v in targets.items() if v is not None})
 
     from ..models import ScaleBias
     from ..planning import predict, suggest
@@ -116,3 +153,39 @@ def _verdict(given, best, target_scale, target_bias, max_speed: float) -> str:
                 "20 revolutions per turn reaches it")
     return (f"the protocol as given misses the {target}; the suggestion is the shortest protocol up to "
             f"{max_speed:g} deg/s that reaches it without a larger std on a target")
+
+
+def _plan_poses(poses, tilt, still, peak_rate, sample_rate, accel_density, gyro_density, targets) -> None:
+    """The whole-IMU hand session: predicted std of both sensors, and the shortest plan for the targets."""
+    from rich.table import Table
+
+    from ..imu.planning import predict_poses, suggest_poses
+
+    options = dict(static_duration=still, peak_rate_deg=peak_rate, sample_rate=sample_rate,
+                   accel_noise_density=accel_density, gyro_noise_density=gyro_density)
+    plans = [("as given", predict_poses(poses, tilt, **options))]
+    if targets:
+        plans.append(("suggested", suggest_poses(targets, **options)))
+    table = Table(title=f"Cramer-Rao prediction of a hand session (gyrocal imu), {sample_rate:g} Hz")
+    table.add_column("")
+    for label, _ in plans:
+        table.add_column(label, justify="right")
+    rows = [("poses", lambda p, f: str(p.poses)), ("tilt between poses (deg)", lambda p, f: f"{p.turn_deg:g}"),
+            ("session time (s)", lambda p, f: f"{p.total_time:.0f}"),
+            ("gyro scale (1e-4)", lambda p, f: f"{1e4 * f['gyro_scale']:.3g}"),
+            ("gyro cross terms (1e-4)", lambda p, f: f"{1e4 * f['gyro_cross']:.3g}"),
+            ("gyro bias (deg/s)", lambda p, f: f"{math.degrees(f['gyro_bias']):.2g}"),
+            ("accel scale (1e-4)", lambda p, f: f"{1e4 * f['accel_scale']:.3g}"),
+            ("accel cross terms (1e-4)", lambda p, f: f"{1e4 * f['accel_cross']:.3g}"),
+            ("accel offset (m/s^2)", lambda p, f: f"{f['accel_offset']:.2g}")]
+    for name, cell in rows:
+        table.add_row(name, *(cell(p, p.figures()) for _, p in plans))
+    console.print(table)
+    console.print(f"noise densities: gyro {gyro_density:.3g} rad/s/sqrt(Hz), accelerometer {accel_density:.3g} "
+                  "m/s^2/sqrt(Hz)", highlight=False, soft_wrap=True)
+    if poses < 12:
+        console.print(f"note: with {poses} poses 'gyrocal imu' fits the accelerometer's scale and offset only (the "
+                      "9-parameter model needs 12 poses to be checked); the accel figures above are for the "
+                      "9-parameter model", highlight=False, soft_wrap=True)
+    console.print("each figure is the largest 1-sigma of its kind; 'inf': the plan does not determine it (a tilt of "
+                  "180 deg only flips the board between two faces)", highlight=False, soft_wrap=True)
