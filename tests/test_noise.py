@@ -1,4 +1,8 @@
-"""Noise figures read off the Allan deviation of simulated static data."""
+"""Noise figures read off the Allan deviation of simulated static data.
+
+References: the Allan deviation of white noise, Gauss-Markov bias and random walk in closed form (IEEE Std
+952), with tolerances from the deviation's own sampling error.
+"""
 
 import math
 
