@@ -180,7 +180,7 @@ def _bad_inputs(tmp_path: Path, servo: Path) -> dict[str, tuple[list, str]]:
         "time goes back": ([variant("back", backwards), *std], "time"),
         "duplicated time": ([variant("dup", duplicated), *std], "time"),
         "saturated": ([variant("sat", saturated), *std], "full scale"),
-        "too few rotations": ([variant("few", few_turns), *std], "y"),
+        "too few rotations": ([variant("few", few_turns), *std], "no rotation about y, z"),  # +x, -x kept
         "deg/s declared as rad/s": ([rad_as_deg, "--units", "rad/s", "--speed", "1.047"], "deg/s"),
         "existing different output": ([servo, *std, "-o", existing], "--force"),
         "speed and angle": ([servo, "--units", "deg/s", "--speed", "60", "--angle", "360"], "not both"),

@@ -60,14 +60,21 @@ def test_noise_density_and_std_agree():
         predicted_std(d, sample_rate=200.0)
 
 
-def test_crb_equals_estimator_covariance_for_six_windows(rng):
+def test_six_window_covariance_has_the_closed_form_for_any_gyro(rng):
+    """Independent reference, worked by hand from eq. 1 and the norm equations: with turns of N samples
+    at speed w about +-j, only axis j's noise enters the two equations of that axis, and solving them gives
+    sd(k_j) = k_j^2 sigma / (w sqrt(2 N)), sd(b_j) = sigma / sqrt(2 N), no correlations. The CRB, the
+    design's prediction and the estimator's own covariance must all equal it."""
     model = ScaleBias(rng.uniform(0.8, 1.2, 3), rng.uniform(-0.1, 0.1, 3))
     d = Design.paper_six(SPEED)
-    np.testing.assert_allclose(predicted_covariance(d, model, 0.035), crb_covariance(d, model, 0.035), rtol=1e-9)
+    n = round(2 * math.pi / SPEED * 200)
+    want = np.diag(np.concatenate([model.k**4 * 0.035**2 / (SPEED**2 * 2 * n), np.full(3, 0.035**2 / (2 * n))]))
+    np.testing.assert_allclose(crb_covariance(d, model, 0.035), want, rtol=1e-9, atol=1e-18)
+    np.testing.assert_allclose(predicted_covariance(d, model, 0.035), want, rtol=1e-9, atol=1e-18)
     obs = expected_observations(d, model, 200.0, noise_std=0.035)
     fit = first_moment_batch(obs, noise_var=np.full(3, 0.035**2))
     np.testing.assert_allclose(fit.params[0], model.params, atol=1e-12)  # noise-free windows
-    np.testing.assert_allclose(fit.covariance[0], crb_covariance(d, model, 0.035), rtol=1e-9, atol=1e-18)
+    np.testing.assert_allclose(fit.covariance[0], want, rtol=1e-9, atol=1e-18)
 
 
 def test_estimator_covariance_is_at_least_the_crb(rng):

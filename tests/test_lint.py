@@ -6,6 +6,7 @@ sources read as text.
 
 from __future__ import annotations
 
+import ast
 import re
 import shutil
 import subprocess
@@ -40,3 +41,25 @@ def test_a_run_with_a_skip_fails(tmp_path):
                          cwd=tmp_path, capture_output=True, text=True, timeout=120, check=False)
     assert out.returncode == 1, out.stdout
     assert "did not run" in out.stdout and "test_planted.py::test_skips" in out.stdout
+
+
+def test_modules_and_functions_stay_small():
+    """No module over 400 lines; no function body over 60 lines (docstring aside) unless its first
+    comment says why (``# long function: ...``)."""
+    problems = []
+    for path in sorted((ROOT / "src" / "gyrocal").rglob("*.py")):
+        text = path.read_text()
+        lines = text.splitlines()
+        if len(lines) > 400:
+            problems.append(f"{path.relative_to(ROOT)}: {len(lines)} lines")
+        for node in ast.walk(ast.parse(text)):
+            if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                continue
+            body = node.body
+            if isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant) and len(body) > 1:
+                body = body[1:]
+            length = node.end_lineno - body[0].lineno + 1
+            head = "\n".join(lines[node.lineno - 1:body[0].lineno + 2])
+            if length > 60 and "# long function:" not in head:
+                problems.append(f"{path.relative_to(ROOT)}:{node.lineno} {node.name}: {length} lines")
+    assert not problems, "\n".join(problems)

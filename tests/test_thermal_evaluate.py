@@ -54,11 +54,36 @@ def test_summary_has_every_rotating_and_gyro_axis(calibrated):
     assert big[("x", "y")] > 10 * big[("x", "z")]
 
 
-def test_loto_comparison_reports_both_models(calibrated):
+def _loto_by_hand(temps: np.ndarray, values: np.ndarray, option, fit) -> float:
+    """RMS error of predicting each node from the others (numpy only)."""
+    errors = []
+    for k in range(len(temps)):
+        keep = np.arange(len(temps)) != k
+        errors.append(fit(temps[keep], values[keep], temps[k], option) - values[k])
+    return float(np.sqrt(np.mean(np.square(errors))))
+
+
+def _lagrange(t, v, at, _):
+    """The parabola through the stencil of docs/thermal.md (first node >= T is i; nodes i-2..i, kept inside)."""
+    i = next((j for j, x in enumerate(t) if x >= at), len(t))
+    s = min(max(i - 2, 0), len(t) - 3)
+    return np.polyval(np.polyfit(t[s:s + 3], v[s:s + 3], 2), at)
+
+
+def _polynomial(t, v, at, order):
+    return np.polyval(np.polyfit(t, v, order), at)
+
+
+def test_loto_comparison_matches_a_by_hand_leave_one_out(calibrated):
+    """Reference: numpy's polyfit through the documented stencil (Lagrange) and of each element's chosen order
+    (smooth), leaving each temperature out in turn."""
     _, cal, _ = calibrated
     rows = loto_comparison(cal)
     assert [r["element"] for r in rows][:3] == ["Kxx", "Kyy", "Kzz"]
-    assert all(r["lagrange_loto_rms"] > 0 and r["smooth_loto_rms"] > 0 for r in rows)
+    for j, row in enumerate(rows):
+        t, v = np.asarray(cal.temps), np.asarray(cal.kg[:, j])
+        assert row["lagrange_loto_rms"] == pytest.approx(_loto_by_hand(t, v, None, _lagrange), rel=1e-6)
+        assert row["smooth_loto_rms"] == pytest.approx(_loto_by_hand(t, v, row["order"], _polynomial), rel=1e-6)
 
 
 def test_report_folder(calibrated, tmp_path):

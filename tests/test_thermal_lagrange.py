@@ -32,10 +32,18 @@ def test_first_interval_uses_the_first_three_nodes():
     assert idx[:, 0].tolist() == [0, 0, 0, 0]
 
 
-def test_stencil_rule_matches_searchsorted_left_everywhere():
-    t = np.linspace(-40, 50, 901)
-    i = np.searchsorted(NODES, t, side="left")
-    assert np.array_equal(stencil(NODES, t), np.clip(i - 2, 0, len(NODES) - 3))
+def test_stencil_follows_the_documented_rule_at_every_node_and_interval():
+    """The rule in words (docs/thermal.md): inside (T[i-1], T[i]) with i >= 2 and at T[i] itself, nodes i-2..i;
+    in [T[0], T[1]], nodes 0..2. Written out node by node, not with searchsorted."""
+    n = len(NODES)
+    temps, want = [], []
+    for i in range(n):
+        temps.append(NODES[i])
+        want.append(max(i - 2, 0))
+        if i >= 1:
+            temps.append((NODES[i - 1] + NODES[i]) / 2)
+            want.append(max(i - 2, 0))
+    assert stencil(NODES, np.array(temps)).tolist() == want
 
 
 def test_weights_sum_to_one_and_reproduce_quadratics_exactly(rng):

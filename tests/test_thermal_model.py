@@ -160,3 +160,15 @@ def test_singular_k_is_refused():
     kg[4, :9] = 0.0
     with pytest.raises(InputError, match="0 degC is singular"):
         ThermalCalibration(temps=TEMPS, kg=kg, smooth=fit_smooth(TEMPS, TRUTH.kg(TEMPS)))
+
+
+@pytest.mark.parametrize(("fs", "tau", "n"), [(200.0, 20.0, 60_000), (1.0, 20.0, 3_000), (100.0, 0.01, 20_000)])
+def test_temperature_smoothing_equals_two_passes_of_scipy_lfilter(rng, fs, tau, n):
+    """Reference: scipy.signal.lfilter, forward then backward, each pass starting at its first reading."""
+    from scipy.signal import lfilter
+
+    x = np.round(20 + np.cumsum(rng.normal(0, 0.01, n)) + rng.normal(0, 0.3, n))  # whole-degree readings
+    a = np.exp(-1 / (fs * tau))
+    y, _ = lfilter([1 - a], [1, -a], x, zi=[a * x[0]])
+    y, _ = lfilter([1 - a], [1, -a], y[::-1], zi=[a * y[-1]])
+    np.testing.assert_allclose(smooth_temperature(x, fs, tau), y[::-1], rtol=1e-11, atol=0)

@@ -126,7 +126,7 @@ def assess_fit(residuals: Sequence[Sequence[float]], labels: Sequence[str], n_pa
     what : str
         What the rows are, for the messages.
     """
-    from scipy.stats import chi2 as chi2_dist
+    from scipy.special import chdtrc  # the chi-square survival function, without scipy.stats's import
 
     z = [np.asarray(r, dtype=float).ravel() for r in residuals]
     per_window = np.array([float(np.dot(r, r)) for r in z])
@@ -138,7 +138,7 @@ def assess_fit(residuals: Sequence[Sequence[float]], labels: Sequence[str], n_pa
         note = (f"no residual degrees of freedom: {rows} equations for {n_params} parameters, so nothing checks "
                 f"{what} against each other; add static windows or repeat turns to let the fit check itself")
         return GoodnessOfFit(chi2, 0, None, None, False, tuple(labels), zs, (), (note,))
-    p = float(chi2_dist.sf(chi2, dof))
+    p = float(chdtrc(dof, chi2))
     birge = math.sqrt(chi2 / dof)
     if p >= P_THRESHOLD:
         return GoodnessOfFit(chi2, dof, p, birge, False, tuple(labels), zs)

@@ -63,6 +63,9 @@ class ReadingFlags:
         self.AccelSensitivity = Annotated[Optional[float], opt(
             "accel-sensitivity", "For --accel-units counts: LSB per g (default: none; counts stay counts).")]
         self.Gravity = Annotated[float, opt("gravity", "One g [m/s^2], for --accel-units g or counts.")]
+        self.Imu = Annotated[Optional[int], opt(
+            "imu", "PX4 ULog / ArduPilot DataFlash log: which IMU instance, from 0 (default: the only one; required "
+                   "when the log holds several).")]
 
 
 #: The reading flags without a prefix.
@@ -94,6 +97,7 @@ def read_from_flags(
     accel_sensitivity: float | None = None,
     gravity: float = STANDARD_GRAVITY,
     need_accel: bool = False,
+    imu: int | None = None,
 ):
     """A :class:`~gyrocal.recording.Recording` from the reading flags (see :func:`gyrocal.io.read_recording`)."""
     from ..io import read_recording
@@ -102,7 +106,7 @@ def read_from_flags(
                           sensitivity=sensitivity,
                           output_units=output_units, topic=topic, check_units=not no_unit_check,
                           saturation=saturation, accel_units=accel_units, accel_sensitivity=accel_sensitivity,
-                          gravity=gravity, need_accel=need_accel)
+                          gravity=gravity, need_accel=need_accel, imu=imu)
 
 
 @contextlib.contextmanager

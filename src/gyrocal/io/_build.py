@@ -176,6 +176,12 @@ def _accel_fields(data: dict, source: str, accel_units: str | None, accel_sensit
             "accel_sensitivity": accel_sensitivity}
 
 
+def _axis_labels(values) -> np.ndarray:
+    """The axis column as text without surrounding blanks (one-letter labels have none to strip)."""
+    labels = np.asarray(values, dtype=str)
+    return labels if labels.dtype.itemsize == 4 else np.char.strip(labels)
+
+
 def build_recording(
     data: dict,
     extra: dict,
@@ -235,7 +241,7 @@ def build_recording(
         "gyro": gyro,
         "temp": data.get("temp"),
         "table_rate": None if "table_rate" not in data else data["table_rate"] * table_factor,
-        "axis": None if "axis" not in data else np.char.strip(np.asarray(data["axis"], dtype=str)),
+        "axis": None if "axis" not in data else _axis_labels(data["axis"]),
         "extra": dict(extra),
         **accel,
     }

@@ -163,6 +163,8 @@ def _read_arrow(path: Path, packed: str | None, layout: Layout, mapping: dict, e
     import pyarrow as pa
     import pyarrow.csv as pcsv
 
+    from ._arrow import numeric_to_numpy, text_to_numpy
+
     names = layout.names
     numeric = [mapping[c] for c in NUMERIC if c in mapping]
 
@@ -197,16 +199,17 @@ def _read_arrow(path: Path, packed: str | None, layout: Layout, mapping: dict, e
     rates = [mapping[c] for c in ("gx", "gy", "gz")]
     cols = {}
     if all(pa.types.is_float64(table.column(n).type) for n in rates):
-        # fill one (3, N) block chunk by chunk: the recording is built on its transpose, a
-        # column-major (N, 3) array, without another copy (see _build._rates_block)
+        # fill one (3, N) block: the recording is built on its transpose, a column-major (N, 3)
+        # array, without another copy (see _build._rates_block)
         block = np.empty((3, table.num_rows))
         for j, name in enumerate(rates):
-            pos = 0
-            for chunk in table.column(name).chunks:
-                block[j, pos:pos + len(chunk)] = chunk.to_numpy(zero_copy_only=False)
-                pos += len(chunk)
-            cols[name] = block[j]
-    return {n: cols[n] if n in cols else table.column(n).to_numpy() for n in names}
+            cols[name] = numeric_to_numpy(table.column(name), out=block[j])
+    for n in names:
+        column = table.column(n)
+        if n not in cols:
+            cols[n] = (numeric_to_numpy(column) if pa.types.is_floating(column.type)
+                       else text_to_numpy(column, dtype=str if n == mapping.get("axis") else object))
+    return cols
 
 
 def _read_python(path: Path, packed: str | None, layout: Layout, encoding: str) -> dict:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import io
 import os
 
 import numpy as np
@@ -24,16 +25,22 @@ def _columns(columns: dict) -> dict[str, np.ndarray]:
     return arrays
 
 
+#: Rows formatted at a time: memory stays bounded whatever the length of the file.
+CHUNK_ROWS = 1 << 18
+_NEEDS_QUOTES = r'[,"\r\n]'
+
+
 def _text(arr: np.ndarray) -> list[str]:
+    """Cells of one chunk without pyarrow: floats as their shortest round-trip text."""
     if arr.dtype.kind == "f":
-        return [repr(float(x)) for x in arr]  # shortest text that reads back to the same float
+        return [repr(x) for x in arr.tolist()]
     if arr.dtype.kind == "b":
-        return ["1" if x else "0" for x in arr]
+        return ["1" if x else "0" for x in arr.tolist()]
     return ["" if x is None else str(x) for x in arr.tolist()]
 
 
 def write_csv(path: str | os.PathLike, columns: dict, *, header_comment: str | None = None) -> None:
-    """Write columns to a comma-separated file, atomically.
+    """Write columns to a comma-separated file, atomically, a chunk of rows at a time.
 
     Parameters
     ----------
@@ -41,19 +48,21 @@ def write_csv(path: str | os.PathLike, columns: dict, *, header_comment: str | N
         Output file; replaced only once the whole file is written.
     columns : dict of str to array_like
         Column name -> 1-D values, written in the dict's order. Floats are written
-        with the shortest text that reads back to the same value; other values as text.
+        with the shortest text that reads back to the same value, booleans as 1 and 0,
+        other values as text (quoted only when a cell holds a comma, a quote or a newline).
     header_comment : str, optional
         Written first, each line prefixed with ``# ``; :func:`read_recording` skips it.
     """
     arrays = _columns(columns)
+    n = len(next(iter(arrays.values())))
     with atomic_path(path) as tmp:
-        if _write_arrow(tmp, arrays, header_comment):
-            return
         with open(tmp, "w", encoding="utf-8", newline="") as f:
             _comment(f, header_comment)
-            writer = csv.writer(f, lineterminator="\n")
-            writer.writerow(list(arrays))
-            writer.writerows(zip(*(_text(a) for a in arrays.values())))
+            f.write(",".join(_quote(k) for k in arrays) + "\n")
+        write_chunk = _arrow_chunk_writer()
+        with open(tmp, "ab") as f:
+            for start in range(0, n, CHUNK_ROWS):
+                write_chunk(f, {k: v[start:start + CHUNK_ROWS] for k, v in arrays.items()})
 
 
 def _comment(f, header_comment: str | None) -> None:
@@ -62,22 +71,30 @@ def _comment(f, header_comment: str | None) -> None:
             f.write(f"# {line}\n")
 
 
-def _write_arrow(tmp, arrays: dict[str, np.ndarray], header_comment: str | None) -> bool:
-    """Fast path for numeric columns; False when pyarrow is missing or a column is not numeric."""
-    if not all(a.dtype.kind in "fiu" for a in arrays.values()):
-        return False
+def _python_chunk(f, chunk: dict[str, np.ndarray]) -> None:
+    text = io.StringIO()
+    csv.writer(text, lineterminator="\n").writerows(zip(*(_text(a) for a in chunk.values())))
+    f.write(text.getvalue().encode("utf-8"))
+
+
+def _arrow_chunk_writer():
+    """A function writing one chunk of columns through pyarrow's CSV writer (the Python one without pyarrow)."""
     try:
         import pyarrow as pa
+        import pyarrow.compute as pc
         import pyarrow.csv as pcsv
+
+        from ._arrow import from_numpy
     except ImportError:
-        return False
-    table = pa.table({k: pa.array(v) for k, v in arrays.items()})
-    with open(tmp, "w", encoding="utf-8", newline="") as f:
-        _comment(f, header_comment)
-        f.write(",".join(_quote(k) for k in arrays) + "\n")
-    with open(tmp, "ab") as f:
-        pcsv.write_csv(table, f, pcsv.WriteOptions(include_header=False))
-    return True
+        return _python_chunk
+
+    def write(f, chunk: dict[str, np.ndarray]) -> None:
+        table = pa.table({k: from_numpy(v) for k, v in chunk.items()})
+        text_columns = [table.column(k) for k, v in chunk.items() if v.dtype.kind not in "fiub"]
+        quote = any(pc.any(pc.match_substring_regex(c, _NEEDS_QUOTES)).as_py() for c in text_columns)
+        pcsv.write_csv(table, f, pcsv.WriteOptions(include_header=False, quoting_style="needed" if quote else "none"))
+
+    return write
 
 
 def _quote(name: str) -> str:

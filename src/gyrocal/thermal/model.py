@@ -27,6 +27,7 @@ order); ``kg_user`` has B in input units and K scaled by output/input unit facto
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar
 
@@ -43,6 +44,7 @@ from ..models import KG_NAMES, kg_to_kb
 from ..recording import Recording
 from ..sections import FitQuality, section
 from ..units import RateUnit, parse_rate_unit, unit_factor
+from ._warn import ThermalRangeWarning
 from .lagrange import check_nodes, interpolate, range_policy
 from .smooth import SmoothModel
 from .tempfilter import DEFAULT_TEMP_TAU, smooth_temperature
@@ -50,6 +52,8 @@ from .tempfilter import DEFAULT_TEMP_TAU, smooth_temperature
 __all__ = ["RULE", "TableModel", "ThermalCalibration"]
 
 _MODELS = values(TableModel)
+#: Samples compensated at a time.
+_CHUNK = 1 << 16
 RULE = ("3-node Lagrange (the full-temperature-range method, eq. 21-22): i = first node >= T, stencil nodes s..s+2 "
         "with s = clip(i-2, 0, n-3)")
 
@@ -171,8 +175,19 @@ class ThermalCalibration:
         """True rates (N, 3) [rad/s] from readings (N, 3) [rad/s] at temperatures (N,) [degC] (eq. 12 inverted)."""
         w = finite_array("gyro", gyro, shape_tail=(3,), ndim=2)
         t = np.broadcast_to(np.asarray(temp, dtype=float), (len(w),))
-        K, B = kg_to_kb(self.kg_at(t, model, out_of_range))
-        return np.linalg.solve(K, (w - B)[..., None])[..., 0]
+        if model not in _MODELS:
+            raise InputError(f"{{param}}={model!r} is not one of {', '.join(_MODELS)}", param="model", value=model)
+        if model != "traditional":  # the range policy once for the record: one refusal or one warning
+            t = range_policy(self.temps, finite_array("temp", t, ndim=1), out_of_range)
+        out = np.empty_like(w)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ThermalRangeWarning)  # already said above
+            # a chunk at a time: the per-sample tables (N, 3, 12) would outgrow the recording itself
+            for start in range(0, len(w), _CHUNK):
+                stop = start + _CHUNK
+                K, B = kg_to_kb(self.kg_at(t[start:stop], model, "extrapolate"))
+                out[start:stop] = np.linalg.solve(K, (w[start:stop] - B)[..., None])[..., 0]
+        return out
 
     def apply(self, rec: Recording, **options) -> Recording:
         """The recording with its gyro compensated in temperature.
