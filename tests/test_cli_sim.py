@@ -15,7 +15,7 @@ from cli_runner import invoke, refused  # noqa: E402
 
 from gyrocal import load_calibration  # noqa: E402
 from gyrocal.io import read_recording  # noqa: E402
-from gyrocal.noise import load_noise  # noqa: E402
+from gyrocal.noise_file import load_noise  # noqa: E402
 
 
 def test_simulated_recording_travels_the_calibration_path(tmp_path):
@@ -87,7 +87,7 @@ def test_noise_command_writes_json_and_plot(tmp_path, rng, monkeypatch):
     assert "bias inst." in out and "\u2026" not in out  # no header cut at 80 columns
     report = load_noise(tmp_path / "n.json")
     # ARW at short tau from 30,000 samples: relative sd well below 1 %
-    np.testing.assert_allclose(report.arw, 0.01 / math.sqrt(100.0), rtol=0.03)
+    np.testing.assert_allclose(report.density, 0.01 / math.sqrt(100.0), rtol=0.03)
     assert (tmp_path / "a.png").stat().st_size > 0
     assert "--units" in refused("noise", static)
     code, out, err = invoke("plan", "--noise-density", tmp_path / "n.json", "--sample-rate", "100")

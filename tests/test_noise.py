@@ -1,17 +1,22 @@
-"""Noise figures read off the Allan deviation of simulated static data.
+"""Noise figures read off the Allan deviation of simulated logs at rest, with their intervals.
 
-References: the Allan deviation of white noise, Gauss-Markov bias and random walk in closed form (IEEE Std
-952), with tolerances from the deviation's own sampling error.
+Independent references: the Allan variance in closed form for white + Gauss-Markov + random
+walk noise (IEEE Std 952 annex C / Stable32 noise models), the known white-noise density of
+the simulation, and the non-overlapping Allan-deviation spread 1/sqrt(2(K-1)) for the
+width of the edf-based intervals (which allantools computes by Greenhall's algorithm).
 """
 
+import json
 import math
 
 import numpy as np
 import pytest
 
-from gyrocal.errors import FileFormatError, InputError
+from gyrocal.errors import FileFormatError, InputError, UnitError
 from gyrocal.models import ScaleBias
-from gyrocal.noise import BI_FACTOR, characterise, load_noise, noise_density_arg, save_noise
+from gyrocal.noise import BI_FACTOR, NoiseWarning, characterise, characterise_recording
+from gyrocal.noise_file import load_noise, noise_density_arg, save_noise
+from gyrocal.recording import Recording
 from gyrocal.simulation import VirtualGyro
 
 FS, HOURS = 100.0, 3.0
@@ -28,7 +33,7 @@ def _avar_theory(tau):
 
 
 def _rel_sd(tau):
-    """Relative standard deviation of an Allan deviation from T / tau clusters (non-overlapping: conservative)."""
+    """Relative sd of an Allan deviation from T / tau non-overlapping clusters (conservative)."""
     clusters = HOURS * 3600 / tau
     return 1.0 / np.sqrt(2 * (clusters - 1))
 
@@ -43,58 +48,173 @@ def report():
 
 
 def test_adev_follows_theory(report):
-    theory = np.sqrt(_avar_theory(report.taus))
-    ok = report.taus < report.taus[-1] / 10  # enough clusters for a tight check
-    assert np.all(np.abs(report.adev[:, ok] / theory[ok] - 1) < 4 * _rel_sd(report.taus[ok]) + 0.02)
+    theory = np.sqrt(_avar_theory(report.gyro.taus))
+    ok = report.gyro.taus < report.gyro.taus[-1] / 10  # enough clusters for a tight check
+    adev = report.gyro.adev[:3, ok]
+    assert np.all(np.abs(adev / theory[ok] - 1) < 4 * _rel_sd(report.gyro.taus[ok]) + 0.02)
 
 
-def test_angle_random_walk_is_the_noise_density(report):
+def test_density_is_the_white_noise_and_inside_its_interval(report):
+    d = report.gyro.density
     expect = SIGMA / math.sqrt(FS)
-    # read on the -1/2 line at short tau, where white noise dominates to < 1 %
-    assert np.all(np.abs(report.arw / expect - 1) < 0.02)
+    half = (d.high - d.low) / 2
+    # read on the -1/2 line at short tau, where white noise dominates to < 1 %; 4 interval half-widths + 1 %
+    assert np.all(np.abs(d.value - expect) < 4 * half + 0.01 * expect), (d.value, half)
     np.testing.assert_allclose(report.noise_std, SIGMA, rtol=0.02)
+    assert np.all(d.low < d.value) and np.all(d.value < d.high)
 
 
 def test_bias_instability_is_the_floor_over_0664(report):
-    theory = np.sqrt(_avar_theory(report.taus))
+    theory = np.sqrt(_avar_theory(report.gyro.taus))
     floor = theory.min() / BI_FACTOR
-    tol = 4 * _rel_sd(report.bias_instability_tau)
-    assert np.all(np.abs(report.bias_instability / floor - 1) < tol), (report.bias_instability, floor, tol)
+    b = report.gyro.bias_instability
+    tol = 4 * _rel_sd(b.tau[:3])
+    assert np.all(np.abs(b.value[:3] / floor - 1) < tol), (b.value, floor, tol)
+    # the overlapping estimator's interval is narrower than the non-overlapping spread, not wildly so
+    rel = (b.high[:3] - b.low[:3]) / 2 / b.value[:3]
+    assert np.all(rel < _rel_sd(b.tau[:3]) * 1.2) and np.all(rel > _rel_sd(b.tau[:3]) / 3), rel
 
 
-def test_rate_random_walk_on_the_plus_half_line(report):
-    # the figure is the +1/2 line through the read point; compare with the theory at that point
+def test_random_walk_on_the_plus_half_line(report):
+    w = report.gyro.random_walk
     for a in range(3):
-        i = np.argmin(np.abs(report.rrw[a] * np.sqrt(report.taus / 3) - report.adev[a]))
-        tau = report.taus[i]
+        tau = w.tau[a]
         expect = math.sqrt(_avar_theory(tau)) * math.sqrt(3 / tau)
-        assert abs(report.rrw[a] / expect - 1) < 4 * _rel_sd(tau), (a, tau, report.rrw[a], expect)
+        assert abs(w.value[a] / expect - 1) < 4 * _rel_sd(tau), (a, tau, w.value[a], expect)
+        assert w.low[a] < w.value[a] < w.high[a]
+    assert np.all(np.isnan(report.gyro.random_walk_bound))  # seen, so no bound
 
 
-def test_white_noise_only_reports_no_floor(rng):
-    m = rng.standard_normal((20000, 3)) * 0.01
-    r = characterise(m, 100.0)
-    assert np.all(np.isnan(r.rrw))
-    assert np.all(np.isnan(r.bias_instability))
+def test_sensor_row_pools_the_axes(report):
+    g = report.gyro
+    np.testing.assert_allclose(g.adev[3], np.sqrt(np.mean(g.adev[:3] ** 2, axis=0)))
+    assert abs(g.density.value[3] / (SIGMA / math.sqrt(FS)) - 1) < 0.01
+    assert g.density.edf[3] > 2 * g.density.edf[0]  # three axes' worth of data
 
 
-def test_json_round_trip(report, tmp_path):
+def test_density_intervals_cover_the_truth_at_their_level():
+    """Coverage over seeds: about 68 % of 1-sigma intervals hold the true density (white noise)."""
+    rng = np.random.default_rng(7)
+    hits = []
+    for _ in range(80):
+        r = characterise(rng.standard_normal((3000, 3)) * SIGMA, FS)
+        d = r.gyro.density
+        truth = SIGMA / math.sqrt(FS)
+        hits.extend((d.low[:3] <= truth) & (truth <= d.high[:3]))
+    rate, n = np.mean(hits), len(hits)
+    assert abs(rate - r.confidence) < 4 * math.sqrt(r.confidence * (1 - r.confidence) / n), rate
+
+
+def test_white_noise_only_reports_no_floor_and_bounds_the_walk(rng):
+    r = characterise(rng.standard_normal((20000, 3)) * 0.01, 100.0)
+    assert np.all(np.isnan(r.gyro.random_walk.value))
+    assert np.all(np.isnan(r.gyro.bias_instability.value))
+    # no random walk in the data: the 95 % bound is positive and above zero walk, of the size
+    # sigma(tau_max) sqrt(3 / tau_max) of the white noise at the longest averaging time
+    tmax = r.gyro.taus[-1]
+    scale = 0.01 / math.sqrt(100.0 * tmax) * math.sqrt(3 / tmax)
+    assert np.all(r.gyro.random_walk_bound > scale * 0.5) and np.all(r.gyro.random_walk_bound < scale * 3)
+
+
+def test_accelerometer_figures_in_si(rng):
+    n, fs = 200_000, 100.0
+    g = rng.standard_normal((n, 3)) * 0.01
+    vrw, walk = 2e-3, 5e-4  # m/s^2/sqrt(Hz), m/s^3/sqrt(Hz)
+    a = np.array([0.0, 0.0, 9.81]) + rng.standard_normal((n, 3)) * vrw * math.sqrt(fs)
+    a += np.cumsum(rng.standard_normal((n, 3)) * walk / math.sqrt(fs), axis=0)
+    r = characterise(g, fs, accel=a)
+    d = r.accel.density
+    assert np.all(np.abs(d.value[:3] - vrw) < 4 * (d.high[:3] - d.low[:3]) / 2 + 0.01 * vrw)
+    w = r.accel.random_walk
+    seen = np.isfinite(w.value)
+    assert seen[3] and np.all(np.abs(w.value[seen] - walk) < 4 * (w.high[seen] - w.low[seen]) / 2 + 0.1 * walk), w
+
+
+def test_a_log_that_moves_is_cut_to_its_longest_still_stretch(rng):
+    fs, n = 100.0, 60_000
+    g = rng.standard_normal((n, 3)) * 0.01
+    g[20_000:21_000, 2] += 0.5  # a 10 s turn at 29 deg/s
+    with pytest.warns(NoiseWarning, match="longest still stretch, 2[01].*-600.0 s"):
+        r = characterise(g, fs)
+    assert r.start > 200 and r.stop == 600.0 and r.motions_left_out == 1
+    assert abs(r.density[2] / (0.01 / 10) - 1) < 0.02  # the turn does not reach the figures
+    with pytest.raises(InputError, match="the log moves .1 motion, at 19.*motion restrict"):
+        characterise(g, fs, motion="refuse")
+
+
+def test_six_turns_are_refused_not_read_as_bias_instability():
+    from gyrocal.simulation import ServoProtocol, simulate_servo
+
+    rec, _ = simulate_servo(VirtualGyro(ScaleBias(np.ones(3), np.zeros(3)), noise_std=0.01), ServoProtocol(),
+                            sample_rate=200.0, rng=np.random.default_rng(3))
+    with pytest.raises(InputError, match="the log moves .*still stretch is [0-3].[0-9] s.*at least 10 s"):
+        characterise_recording(rec)
+
+
+def test_constant_and_all_zero_data_are_refused(rng):
+    with pytest.raises(InputError, match="axis x reads 0 in every sample"):
+        characterise(np.zeros((5000, 3)), 100.0)
+    g = rng.standard_normal((5000, 3)) * 0.01
+    g[:, 1] = 0.25
+    with pytest.raises(InputError, match="axis y reads 0.25 in every sample"):
+        characterise(g, 100.0)
+
+
+def test_counts_without_a_sensitivity_are_refused(rng):
+    rec = Recording.from_rate(np.round(rng.standard_normal((5000, 3)) * 20), 100.0, units="counts",
+                              source_units="counts")
+    with pytest.raises(UnitError, match="raw counts; give sensitivity"):
+        characterise_recording(rec)
+
+
+def test_too_short_record_is_refused(rng):
+    with pytest.raises(InputError, match="at least 100"):
+        characterise(rng.standard_normal((50, 3)), 100.0)
+
+
+def test_file_round_trip_and_density_argument(report, tmp_path):
     path = tmp_path / "noise.json"
     save_noise(path, report)
     back = load_noise(path)
-    np.testing.assert_array_equal(back.adev, report.adev)
-    np.testing.assert_array_equal(back.rrw, report.rrw)
-    np.testing.assert_allclose(noise_density_arg(str(path)), report.arw)
+    np.testing.assert_array_equal(back.gyro.adev, report.gyro.adev)
+    np.testing.assert_array_equal(back.gyro.random_walk.high, report.gyro.random_walk.high)
+    np.testing.assert_array_equal(back.gyro.bias_instability.edf, report.gyro.bias_instability.edf)
+    assert back.accel is None and back.samples == report.samples
+    np.testing.assert_allclose(noise_density_arg(str(path)), report.density)
 
 
-def test_load_rejects_bad_fields(report, tmp_path):
-    import json
-
-    doc = report.to_dict()
-    doc["arw"] = [1.0, 2.0]
-    path = tmp_path / "bad.json"
+def test_zero_density_files_are_refused(report, tmp_path):
+    path = tmp_path / "zero.json"
+    save_noise(path, report)
+    doc = json.loads(path.read_text())
+    doc["gyroscope"]["y"]["density"]["value"] = 0.0
     path.write_text(json.dumps(doc))
-    with pytest.raises(FileFormatError, match="arw"):
+    with pytest.raises(FileFormatError, match="gyroscope.y.density.value' must be a number > 0"):
+        load_noise(path)
+    with pytest.raises(InputError, match="gives a zero noise density on y"):
+        noise_density_arg(str(path))
+
+
+def _v1_doc():
+    """A version 1 noise file as ``gyrocal noise --json`` wrote it before intervals existed."""
+    taus = [0.01, 0.1, 1.0]
+    return {"format": "gyrocal.noise", "version": 1, "sample_rate": 100.0, "duration": 60.0,
+            "arw": [1e-3, 2e-3, 3e-3], "noise_std": [1e-2, 2e-2, 3e-2], "bias_instability": [None, 1e-5, None],
+            "bias_instability_tau": [None, 10.0, None], "rrw": [None, None, None], "taus": taus,
+            "adev": [[1e-2, 3e-3, 1e-3], [2e-2, 6e-3, 2e-3], [3e-2, 9e-3, 3e-3]]}
+
+
+def test_version_1_files_still_load(tmp_path):
+    path = tmp_path / "v1.json"
+    path.write_text(json.dumps(_v1_doc()))
+    r = load_noise(path)
+    np.testing.assert_allclose(r.density, [1e-3, 2e-3, 3e-3])
+    assert np.isnan(r.gyro.density.low).all() and r.gyro.bias_instability.value[1] == 1e-5
+    np.testing.assert_allclose(noise_density_arg(str(path)), [1e-3, 2e-3, 3e-3])
+    doc = _v1_doc()
+    doc["arw"] = [1.0, 0.0, 1.0]
+    path.write_text(json.dumps(doc))
+    with pytest.raises(FileFormatError, match="> 0"):
         load_noise(path)
 
 
@@ -107,16 +227,13 @@ def test_noise_density_argument():
         noise_density_arg("-1")
 
 
-def test_too_short_record_is_refused():
-    with pytest.raises(InputError, match="at least 100"):
-        characterise(np.zeros((10, 3)), 100.0)
-
-
-def test_allan_plot_draws_every_axis(report):
+def test_allan_plot_draws_every_axis_in_the_chosen_unit(report):
     from gyrocal.plotting import new_figure
     from gyrocal.plotting.noise import allan_deviation_plot
 
     fig = new_figure()
-    art = allan_deviation_plot(fig.subplots(), report)
-    assert len(art["adev"]) == 3 and len(art["arw"]) == 3 and len(art["rrw"]) == 3 and len(art["bias"]) == 3
-    np.testing.assert_array_equal(art["adev"][0].get_ydata(), report.adev[0])
+    ax = fig.subplots()
+    art = allan_deviation_plot(ax, report.gyro, unit="deg/s")
+    assert [len(art[k]) for k in ("adev", "density", "random_walk", "bias")] == [3, 3, 3, 3]
+    np.testing.assert_allclose(art["adev"][0].get_ydata(), np.degrees(report.gyro.adev[0]))
+    assert "deg/s" in ax.get_ylabel()

@@ -24,6 +24,12 @@ EXPORTER_MODULES: dict[str, str] = {
     "json": "gyrocal.exporters",
     "yaml": "gyrocal.exporters",
     "c-header": "gyrocal.exporters",
+    "imucal": "gyrocal.imucal_export",
+    "kalibr": "gyrocal.flight_exporters",
+    "vins": "gyrocal.flight_exporters",
+    "imu_utils": "gyrocal.flight_exporters",
+    "px4": "gyrocal.flight_exporters",
+    "ardupilot": "gyrocal.flight_exporters",
 }
 #: The export formats, in the order the command line lists them.
 EXPORT_FORMATS: tuple[str, ...] = tuple(EXPORTER_MODULES)

@@ -29,6 +29,8 @@ KIND_MODULES: dict[str, str] = {
     "gyrocal.calibration": "gyrocal.calibration",
     "gyrocal.thermal": "gyrocal.thermal.model",
     "gyrocal.simulation-truth": "gyrocal.simulation.truth",
+    "gyrocal.noise": "gyrocal.noise_file",
+    "gyrocal.thermal-bias": "gyrocal.thermal_bias_file",
     "gyrocal.verify": "gyrocal.verify.report",
 }
 
@@ -120,6 +122,8 @@ def load(path: str | os.PathLike, kind: type | tuple[type, ...] | None = None) -
 def save(obj: Any, path: str | os.PathLike) -> None:
     """Write ``obj.to_document()`` to `path` as JSON, atomically."""
     fmt = getattr(type(obj), "FORMAT", None)
+    if isinstance(fmt, str) and fmt not in _KINDS and fmt in KIND_MODULES:
+        importlib.import_module(KIND_MODULES[fmt])  # a kind whose file code registers it from another module
     if fmt not in _KINDS or not isinstance(obj, _KINDS[fmt]):
         raise InputError(f"{type(obj).__name__} is not a registered gyrocal file kind; it cannot be saved")
     write_json(path, obj.to_document())

@@ -13,6 +13,11 @@ reader of files accepts old ones. The steps, and what changed:
 ``gyrocal.thermal`` 1 -> 2
     ``kg_names`` becomes ``kg_order``; the interpolation rule names the method instead
     of an internal label; the optional ``fit`` section appears (null).
+
+``gyrocal.noise`` 1 -> 2
+    Per-axis gyro lists (``arw``, ``bias_instability``, ``rrw``) become figures per axis and
+    for the sensor (``gyroscope.x.density.value``, ...) with intervals (null: unknown); the
+    accelerometer section appears (null). See :func:`gyrocal.noise_file.upgrade_v1`.
 """
 
 from __future__ import annotations
@@ -74,10 +79,17 @@ def _thermal_1_to_2(doc: dict, path) -> dict:
     return out
 
 
+def _noise_1_to_2(doc: dict, path) -> dict:
+    from .noise_file import upgrade_v1
+
+    return upgrade_v1(doc, path)
+
+
 #: (format, version) -> the step to version + 1.
 UPGRADES: dict[tuple[str, int], Upgrade] = {
     ("gyrocal.calibration", 1): _calibration_1_to_2,
     ("gyrocal.thermal", 1): _thermal_1_to_2,
+    ("gyrocal.noise", 1): _noise_1_to_2,
 }
 
 

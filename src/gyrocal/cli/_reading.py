@@ -9,6 +9,7 @@ makes a second set with a prefix (``ReadingFlags("ref-")`` gives ``--ref-units``
 from __future__ import annotations
 
 import contextlib
+import re
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -63,6 +64,9 @@ class ReadingFlags:
         self.AccelSensitivity = Annotated[Optional[float], opt(
             "accel-sensitivity", "For --accel-units counts: LSB per g (default: none; counts stay counts).")]
         self.Gravity = Annotated[float, opt("gravity", "One g [m/s^2], for --accel-units g or counts.")]
+        self.Imu = Annotated[Optional[int], opt(
+            "imu", "PX4 ULog / ArduPilot DataFlash log: which IMU instance, from 0 (default: the only one; required "
+                   "when the log holds several).")]
 
 
 #: The reading flags without a prefix.
@@ -94,6 +98,7 @@ def read_from_flags(
     accel_sensitivity: float | None = None,
     gravity: float = STANDARD_GRAVITY,
     need_accel: bool = False,
+    imu: int | None = None,
 ):
     """A :class:`~gyrocal.recording.Recording` from the reading flags (see :func:`gyrocal.io.read_recording`)."""
     from ..io import read_recording
@@ -102,18 +107,26 @@ def read_from_flags(
                           sensitivity=sensitivity,
                           output_units=output_units, topic=topic, check_units=not no_unit_check,
                           saturation=saturation, accel_units=accel_units, accel_sensitivity=accel_sensitivity,
-                          gravity=gravity, need_accel=need_accel)
+                          gravity=gravity, need_accel=need_accel, imu=imu)
 
 
 @contextlib.contextmanager
 def prefixed_params(prefix: str):
     """Errors raised inside the block name the prefixed flags: reading a reference log with
-    ``prefixed_params("ref_")``, a bad ``units`` shows as ``--ref-units`` (when that flag exists)."""
+    ``prefixed_params("ref_")``, a bad ``units`` shows as ``--ref-units``, and a hint's
+    ``{param:check_units}`` as ``--ref-no-unit-check`` (where those flags exist)."""
     from ._flags import FLAGS
+
+    def prefixed(name: str) -> str:
+        return f"{prefix}{name}" if f"{prefix}{name}" in FLAGS else name
 
     try:
         yield
     except GyrocalError as exc:
-        if exc.param is not None and f"{prefix}{exc.param}" in FLAGS:
-            exc.param = f"{prefix}{exc.param}"
+        if exc.param is not None:
+            exc.param = prefixed(exc.param)
+        other = re.compile(r"\{param:([A-Za-z_]\w*)\}")
+        exc.message = other.sub(lambda m: f"{{param:{prefixed(m.group(1))}}}", exc.message)
+        if exc.hint:
+            exc.hint = other.sub(lambda m: f"{{param:{prefixed(m.group(1))}}}", exc.hint)
         raise

@@ -82,7 +82,7 @@ def _noise_to_internal(noise_std: float | None, units: str, rate_unit: str, sens
 
 def _density_to_internal(noise_density: str, noise_std: float | None, rec):
     """--noise-density (rad/s/sqrt(Hz), per axis) as per-sample noise [rad/s] at the recording's rate."""
-    from ..noise import noise_density_arg
+    from ..noise_file import noise_density_arg
 
     if noise_std is not None:
         raise InputError("give --noise-std or --noise-density, not both")
@@ -375,7 +375,7 @@ def segments(
         from ..plotting import save_figure
         from ..plotting.calibration import calibration_figure
 
-        save_figure(calibration_figure(rec, found, title=f"{recording.name}: windows {source}"), plot)
+        save_figure(calibration_figure(rec, found, title=f"{recording.name}: windows {source}", ignored=ignored), plot)
         console.print(f"wrote {plot}", highlight=False)
 
 

@@ -1,4 +1,4 @@
-"""Command ``noise``: Allan deviation of a static recording."""
+"""Command ``noise``: Allan deviation of a log at rest, with the figures' intervals."""
 
 from __future__ import annotations
 
@@ -8,53 +8,104 @@ from typing import Annotated, Optional
 
 import typer
 
+from ..choices import MotionPolicy
 from ..errors import InputError
 from ._outputs import check_output, json_format
-from ._reading import READING, read_from_flags
+from ._reading import READING, read_from_flags, required_units
 from .app import app, console
 
 __all__ = ["noise"]
 
 
+def _cell(fig, r: int, factor: float, missing: str) -> str:
+    """A figure above its interval as percentages: ``5.01e-04`` above ``-0.2/+0.2%``."""
+    v = fig.value[r] * factor
+    if not math.isfinite(v):
+        return missing
+    if not (math.isfinite(fig.low[r]) and math.isfinite(fig.high[r])):
+        return f"{v:.3g}"
+    low, high = 100 * (1 - fig.low[r] * factor / v), 100 * (fig.high[r] * factor / v - 1)
+    return f"{v:.3g}\n-{low:.2g}/+{high:.2g}%"
+
+
+#: Column heads (density, bias instability, random walk) per displayed unit.
+_HEADS = {"rad/s": ("rad/s/\u221aHz", "rad/s", "rad/s\u00b2/\u221aHz"),
+          "deg/s": ("deg/s/\u221aHz", "deg/s", "deg/s\u00b2/\u221aHz"),
+          "m/s^2": ("m/s\u00b2/\u221aHz", "m/s\u00b2", "m/s\u00b3/\u221aHz")}
+
+
+def _table(title: str, sensor, fs: float, unit: str, factor: float):
+    from rich.table import Table
+
+    density, bias, walk = _HEADS[unit]
+    table = Table(title=title, caption="each figure above its interval")
+    # short names over their units, so the table fits 80 columns without cutting a number
+    for col in ("axis", f"density\n{density}", f"\u03c3/sample\n{bias}", f"bias inst.\n{bias}", "at \u03c4\ns",
+                f"random walk\n{walk}"):
+        table.add_column(col, justify="right", no_wrap=True)
+    std = sensor.noise_std(fs) * factor
+    tau = sensor.bias_instability.tau
+    for r, name in enumerate(("x", "y", "z", "sensor")):
+        table.add_row(name, _cell(sensor.density, r, factor, "-"), f"{std[r]:.3g}",
+                      _cell(sensor.bias_instability, r, factor, "not reached"),
+                      f"{tau[r]:.3g}" if math.isfinite(tau[r]) else "-",
+                      _cell(sensor.random_walk, r, factor, "not seen"))
+    return table
+
+
 @app.command()
 def noise(
-    recording: Annotated[Path, typer.Argument(help="Static recording: CSV, Parquet or a ROS/MCAP bag.")],
+    recording: Annotated[Path, typer.Argument(
+        help="Log at rest: CSV, Parquet, ROS/MCAP bag, PX4 .ulg, ArduPilot .bin.")],
     units: READING.Units = None,
     columns: READING.Columns = None,
     sample_rate: READING.SampleRate = None,
+    sensitivity: READING.Sensitivity = None,
+    output_units: READING.OutputUnits = None,
+    topic: READING.Topic = None,
+    no_unit_check: READING.NoUnitCheck = False,
+    accel_units: READING.AccelUnits = None,
+    accel_sensitivity: READING.AccelSensitivity = None,
+    gravity: READING.Gravity = 9.80665,
+    imu: READING.Imu = None,
+    motion: Annotated[MotionPolicy, typer.Option(
+        "--motion", help="A log that moves: analyse its longest still stretch (restrict) or refuse it.")] = "restrict",
     plot: Annotated[Optional[Path], typer.Option(
         "--plot", help="Allan deviation plot (.png, .pdf, .svg) (default: none).")] = None,
     json_out: Annotated[Optional[Path], typer.Option(
-        "--json", help="Write the noise figures as JSON (default: none).")] = None,
+        "--json", help="Write the noise file, gyrocal.noise (default: none).")] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace a --json file that is not a noise file.")]
     = False,
 ) -> None:
-    """Allan deviation of a static recording: angle random walk, bias instability, rate random walk."""
-    from rich.table import Table
+    """Allan deviation of a log at rest: noise density, bias instability and random walk, with intervals."""
+    from ..noise import FORMAT, characterise_recording
+    from ..noise_file import save_noise
+    from ..units import parse_rate_unit, unit_factor
 
-    from ..noise import FORMAT, characterise, save_noise
-
+    # every output is checked before anything is read, computed or written
     check_output(json_out, flag="--json", inputs=(recording,), force=force, replaceable=json_format(FORMAT))
     check_output(plot, flag="--plot", inputs=(recording, json_out), force=True)
+    if plot is not None:
+        from ..plotting import check_figure_path
 
-    if units is None:
-        raise InputError("--units is required (rad/s or deg/s): the Allan deviation is reported in physical units")
-    rec = read_from_flags(recording, units=units, columns=columns, sample_rate=sample_rate)
-    report = characterise(rec.gyro, rec.sample_rate)
-    table = Table(title=f"{recording.name}: {report.duration:.0f} s at {report.sample_rate:g} Hz")
-    # Short names over their units, so the table fits 80 columns without cutting a header.
-    for col in ("axis", "ARW\ndeg/\u221ah", "density\nrad/s/\u221aHz", "\u03c3/sample\nrad/s", "bias inst.\ndeg/h",
-                "at \u03c4\ns", "RRW\ndeg/h/\u221ah"):
-        table.add_column(col, justify="right", no_wrap=True)
-    def shown(value: float, factor: float, missing: str) -> str:
-        return f"{value * factor:.4g}" if math.isfinite(value) else missing
-
-    deg_h = math.degrees(1.0) * 3600
-    for a in range(3):
-        table.add_row("xyz"[a], shown(report.arw[a], math.degrees(1.0) * 60, "-"), f"{report.arw[a]:.4g}",
-                      f"{report.noise_std[a]:.4g}", shown(report.bias_instability[a], deg_h, "not reached"),
-                      shown(report.bias_instability_tau[a], 1.0, "-"), shown(report.rrw[a], deg_h * 60, "not seen"))
-    console.print(table)
+        check_figure_path(plot)
+        if json_out is not None and plot.absolute() == json_out.absolute():
+            raise InputError(f"--plot and --json are both {plot}; give two different files")
+    unit = required_units(units)
+    if unit == "counts" and sensitivity is None:
+        raise InputError("noise figures are physical quantities, so raw counts need their sensitivity",
+                         param="sensitivity", hint="give {param} (LSB per --output-units, e.g. 131 for a +-250 deg/s "
+                                                    "MPU-9250)")
+    rec = read_from_flags(recording, units=unit, columns=columns, sample_rate=sample_rate, sensitivity=sensitivity,
+                          output_units=output_units, topic=topic, no_unit_check=no_unit_check,
+                          accel_units=accel_units, accel_sensitivity=accel_sensitivity, gravity=gravity, imu=imu)
+    report = characterise_recording(rec, motion=motion, source={"file": recording.name})
+    shown = parse_rate_unit(output_units or "deg/s") if unit == "counts" else unit
+    fs = report.sample_rate
+    head = f"{report.duration:.0f} s at {fs:g} Hz, {100 * report.confidence:.0f} % intervals"
+    console.print(_table(f"{recording.name}: gyro, {head}", report.gyro, fs, shown, 1.0 / unit_factor(shown)))
+    if report.accel is not None:
+        console.print(_table(f"{recording.name}: accelerometer", report.accel, fs, "m/s^2", 1.0))
     if json_out is not None:
         save_noise(json_out, report)
         console.print(f"wrote {json_out}")

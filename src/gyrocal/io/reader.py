@@ -22,6 +22,10 @@ def _kind(path: Path) -> str:
             return "bag"
         raise InputError(f"{path}: a folder, but not a ROS 2 bag (no metadata.yaml, .db3 or .mcap inside)")
     suffix = path.suffix.lower()
+    from .flightlog import flight_log_kind
+
+    if flight_log_kind(path) is not None:
+        return "flight"
     if suffix in (".parquet", ".pq"):
         return "parquet"
     if suffix in BAG_SUFFIXES:
@@ -54,6 +58,7 @@ def read_recording(
     accel_sensitivity: float | None = None,
     gravity: float = STANDARD_GRAVITY,
     need_accel: bool = False,
+    imu: int | None = None,
 ) -> Recording:
     """Read a gyro recording from a file and check it.
 
@@ -62,8 +67,8 @@ def read_recording(
     path : path-like
         A delimited text table (``.csv .txt .tsv .dat``, plain or compressed: gzip, bz2, xz,
         zstd, lz4, brotli or a zip holding one file), a ``.parquet`` file, a ROS 1 ``.bag``, a
-        ROS 2 bag folder or its ``.db3`` / ``.mcap`` file. The format is chosen by suffix,
-        then by the file's first bytes.
+        ROS 2 bag folder or its ``.db3`` / ``.mcap`` file, a PX4 ULog (``.ulg``) or an ArduPilot
+        DataFlash log (``.bin``). The format is chosen by suffix, then by the file's first bytes.
     units : {"rad/s", "deg/s", "counts"}
         Unit of the rate columns as written in the file.
     columns : dict or str, optional
@@ -106,6 +111,9 @@ def read_recording(
         One g [m/s^2], for ``g`` and for counts with a sensitivity (default 9.80665).
     need_accel : bool
         Refuse a call without `accel_units` (for commands that need the accelerometer).
+    imu : int, optional
+        For a PX4 ULog or ArduPilot DataFlash log (:func:`gyrocal.io.read_flight_log`): which
+        IMU instance, needed when the log holds several.
 
     Returns
     -------
@@ -125,6 +133,16 @@ def read_recording(
                          hint="give {param} m/s^2, g or counts (with the accelerometer sensitivity for counts)")
     accel = accel_units is not None
     kind = _kind(path)
+    if kind == "flight":
+        from .flightlog import read_flight_log
+
+        if columns or skip_rows is not None or sample_rate is not None:
+            raise InputError(f"{path.name}: columns, skip_rows and sample_rate do not apply to PX4 and ArduPilot logs "
+                             "(their IMU fields and time stamps are used)")
+        return read_flight_log(path, imu=imu, units=units, check_units=check_units, saturation=saturation,
+                               accel_units=accel_units)[0]
+    if imu is not None:
+        raise InputError(f"imu applies only to PX4 ULog and ArduPilot DataFlash logs, not to {path.name}", param="imu")
     if skip_rows is not None:
         if kind != "text":
             raise InputError(f"{{param}} applies to text tables only; {path.name} is a {kind} file", param="skip_rows")

@@ -5,6 +5,6 @@ artists it made; none touches pyplot's global state. Import the module you need,
 for example ``from gyrocal.plotting.calibration import calibration_figure``.
 """
 
-from .figure import new_figure, save_figure
+from .figure import check_figure_path, new_figure, save_figure
 
-__all__ = ["new_figure", "save_figure"]
+__all__ = ["check_figure_path", "new_figure", "save_figure"]

@@ -1,0 +1,87 @@
+"""Command ``thermal-bias``: gyro bias against temperature from a still log of a warming board."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ._outputs import check_output, json_format
+from ._reading import READING, read_from_flags, required_units
+from .app import app, console
+
+__all__ = ["thermal_bias"]
+
+
+def _read(log: Path, units, columns, sample_rate, sensitivity, output_units, imu):
+    """The recording and what the log says about its IMU (PX4 device id, ArduPilot IMU number)."""
+    from ..io.flightlog import flight_log_kind, read_flight_log
+
+    if log.is_file() and flight_log_kind(log) is not None:
+        rec, info = read_flight_log(log, imu=imu, units=units)
+        return rec, {"file": log.name, **info}
+    rec = read_from_flags(log, units=required_units(units), columns=columns, sample_rate=sample_rate,
+                          sensitivity=sensitivity, output_units=output_units, imu=imu)
+    return rec, {"file": log.name}
+
+
+def _summary(tb, unit: str, factor: float):
+    import numpy as np
+    from rich.table import Table
+
+    table = Table(title=f"bias = sum X_n (T - {tb.tref:.2f})^n, T clipped to {tb.tmin:.2f}..{tb.tmax:.2f} degC",
+                  caption="bias above its 1-sigma")
+    for col in ("axis", "order", f"at {tb.tmin:.1f} C\n{unit}", f"at {tb.tref:.1f} C\n{unit}",
+                f"at {tb.tmax:.1f} C\n{unit}", f"1-sigma max\n{unit}", f"residual\n{unit}"):
+        table.add_column(col, justify="right", no_wrap=True)
+    temps = [tb.tmin, tb.tref, tb.tmax]
+    bias, sd = tb.bias_at(temps) * factor, tb.std_at(temps) * factor
+    worst = tb.std_at(np.linspace(tb.tmin, tb.tmax, 25)).max(axis=0) * factor
+    for a, axis in enumerate("xyz"):
+        table.add_row(axis, str(int(tb.orders[a])), *(f"{bias[i, a]:.4g}\n\u00b1{sd[i, a]:.2g}" for i in range(3)),
+                      f"{worst[a]:.2g}", f"{tb.residual_rms[a] * factor:.2g}")
+    return table
+
+
+@app.command("thermal-bias")
+def thermal_bias(
+    log: Annotated[Path, typer.Argument(help="Still log of a warming board: PX4 .ulg, ArduPilot .bin, CSV, ...")],
+    output: Annotated[Optional[Path], typer.Option(
+        "-o", "--output", help="Thermal-bias file to write, JSON (default: none, print only).")] = None,
+    units: READING.Units = None,
+    columns: READING.Columns = None,
+    sample_rate: READING.SampleRate = None,
+    sensitivity: READING.Sensitivity = None,
+    output_units: READING.OutputUnits = None,
+    imu: READING.Imu = None,
+    max_order: Annotated[int, typer.Option("--max-order", help="Highest order tried, 0-3 (firmwares take cubics).")]
+    = 3,
+    min_span: Annotated[float, typer.Option(
+        "--min-span", help="Smallest temperature span accepted [degC] (ArduPilot's minimum: 10).")] = 10.0,
+    force: Annotated[bool, typer.Option("--force", help="Replace an -o file that is not a thermal-bias file.")]
+    = False,
+) -> None:
+    """Fit gyro bias against temperature for PX4 and ArduPilot (export with --format px4 or ardupilot)."""
+    from ..files import save
+    from ..flight import ThermalBias, fit_thermal_bias
+    from ..units import unit_factor
+
+    check_output(output, inputs=(log,), force=force, replaceable=json_format(ThermalBias.FORMAT))
+    rec, source = _read(log, units, columns, sample_rate, sensitivity, output_units, imu)
+    if rec.temp is None:
+        from ..errors import InputError
+
+        raise InputError(f"{log.name} has no temperature column; a thermal-bias fit needs one", param="columns",
+                         hint="map it with {param} temp=NAME")
+    fs = (len(rec) - 1) / float(rec.t[-1] - rec.t[0]) if rec.has_time else rec.sample_rate
+    source["units"] = rec.source_units
+    tb = fit_thermal_bias(rec.gyro, rec.temp, fs, max_order=max_order, min_span=min_span, source=source)
+    shown = rec.source_units if rec.source_units in ("rad/s", "deg/s") else (output_units or "deg/s")
+    console.print(_summary(tb, shown, 1.0 / unit_factor(shown)))
+    console.print(f"{tb.duration:.0f} s at {fs:.4g} Hz; white noise {math.degrees(float(tb.noise_std.mean())):.3g} "
+                  "deg/s per sample; orders chosen by leave-one-temperature-segment-out error", highlight=False)
+    if output is not None:
+        save(tb, output)
+        console.print(f"wrote {output}")

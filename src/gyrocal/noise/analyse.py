@@ -1,0 +1,135 @@
+"""From readings at rest to a :class:`~.report.NoiseReport`, checking that they are at rest.
+
+Refused: raw counts (no physical unit), an axis whose readings never change (all zero, a
+dead or unmapped column), a log without a long enough still stretch, and figures that
+come out zero. A log that moves somewhere is cut to its longest still stretch, with a
+warning: an Allan deviation needs contiguous samples, and pasting still stretches together
+would join different bias levels with steps that read as noise.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+from .._validation import finite_array, positive
+from ..choices import MotionPolicy, values
+from ..errors import GyrocalWarning, InputError, UnitError
+from ..recording import Recording
+from ..stillness import find_motion
+from .allan import MIN_SAMPLES, ONE_SIGMA, allan_deviation
+from .figures import read_figures
+from .report import NoiseReport, SensorNoise
+
+__all__ = ["MotionPolicy", "NoiseWarning", "characterise", "characterise_recording"]
+
+#: The shortest still stretch a log that moves is cut to [s]; shorter ones are refused.
+MIN_STILL_S = 10.0
+#: Fewer distinct readings than this on an axis: quantisation, not noise, shapes the short-tau curve.
+_FEW_LEVELS = 8
+
+
+class NoiseWarning(GyrocalWarning):
+    """The noise analysis used part of the log, or its input limits the figures."""
+
+
+def _check_axes(name: str, x: np.ndarray, labels: tuple[str, ...], found: list[str]) -> None:
+    for j, label in enumerate(labels):
+        col = x[:, j]
+        if col.min() == col.max():
+            raise InputError(f"{name} axis {label} reads {float(col[0]):g} in every sample: a constant column holds "
+                             "no noise to analyse (a dead sensor, or the wrong column mapped?)")
+        levels = len(np.unique(col[: 200_000]))
+        if levels < _FEW_LEVELS:
+            found.append(f"{name} axis {label} takes only {levels} distinct values: quantisation shapes the "
+                         "short averaging times, so the density is that of the quantisation steps")
+
+
+def _sensor(kind, x, fs, level) -> SensorNoise:
+    taus, adev = allan_deviation(x, fs)
+    curves, density, bias, walk, bound = read_figures(taus, adev, fs, len(x), level=level)
+    if not np.all(density.value > 0):
+        bad = "xyz"[int(np.argmin(np.nan_to_num(density.value[:3], nan=0.0) > 0))]
+        raise InputError(f"the {kind} has no white-noise (-1/2 slope) region on axis {bad}, so no noise density can "
+                         "be read: the data look filtered or oversampled; log the sensor's own output rate")
+    return SensorNoise(kind, taus, curves, density, bias, walk, bound)
+
+
+def characterise(gyro, sample_rate: float, *, accel=None, motion: MotionPolicy = "restrict",
+                 level: float = ONE_SIGMA, source: dict | None = None) -> NoiseReport:
+    """Allan deviation and noise figures, with intervals, of a log at rest.
+
+    Parameters
+    ----------
+    gyro : array_like, shape (N, 3)
+        Gyro readings [rad/s]; constant biases and the Earth rate do not matter.
+    sample_rate : float
+        Sampling rate [Hz].
+    accel : array_like, shape (N, 3), optional
+        Accelerometer readings [m/s^2]; gravity is a constant and does not matter.
+    motion : {"restrict", "refuse"}
+        What to do when the log moves: analyse its longest still stretch (with a
+        :class:`NoiseWarning`), or raise.
+    level : float
+        Confidence of every interval (default 1 sigma, 0.683).
+    source : dict, optional
+        Where the data came from, recorded in the report.
+
+    Raises
+    ------
+    InputError
+        Constant axes, no still stretch of at least 100 samples, or no white-noise region.
+    """
+    g = finite_array("gyro", gyro, shape_tail=(3,), ndim=2)
+    a = None if accel is None else finite_array("accel", accel, shape_tail=(3,), ndim=2)
+    if a is not None and len(a) != len(g):
+        raise InputError(f"accel has {len(a)} samples but gyro has {len(g)}")
+    fs = positive("sample_rate", sample_rate)
+    if motion not in values(MotionPolicy):
+        raise InputError(f"{{param}}={motion!r} is not one of {', '.join(values(MotionPolicy))}", param="motion",
+                         value=motion)
+    found: list[str] = []
+    _check_axes("gyro", g, ("x", "y", "z"), found)
+    if a is not None:
+        _check_axes("accelerometer", a, ("x", "y", "z"), found)
+    still = find_motion([g] if a is None else [g, a], fs)
+    start, stop = 0, len(g)
+    if not still.still:
+        start, stop = still.longest_still()
+        what = f"the log moves ({still.describe(fs)})"
+        longest = f"its longest still stretch is {(stop - start) / fs:.1f} s"
+        if stop - start < max(MIN_SAMPLES, MIN_STILL_S * fs):
+            raise InputError(f"{what}; {longest}, and a noise analysis needs the sensor at rest for at least "
+                             f"{MIN_STILL_S:g} s: record it lying still, untouched")
+        if motion == "refuse":
+            raise InputError(f"{what}: record the sensor lying still, untouched, or analyse only the longest "
+                             f"still stretch, {(stop - start) / fs:.1f} s ({{param}} restrict)", param="motion")
+        found.append(f"{what}: analysed the longest still stretch, {start / fs:.1f}-{stop / fs:.1f} s "
+                     f"({(stop - start) / fs:.1f} s of {len(g) / fs:.1f} s)")
+    for message in found:
+        warnings.warn(message, NoiseWarning, stacklevel=2)
+    gyro_noise = _sensor("gyroscope", g[start:stop], fs, level)
+    accel_noise = None if a is None else _sensor("accelerometer", a[start:stop], fs, level)
+    return NoiseReport(gyro_noise, accel_noise, fs, stop - start, start / fs, stop / fs, len(g) / fs,
+                       motions_left_out=len(still.spans), confidence=level, source=dict(source or {}),
+                       warnings=tuple(found))
+
+
+def characterise_recording(rec: Recording, *, motion: MotionPolicy = "restrict", level: float = ONE_SIGMA,
+                           source: dict | None = None) -> NoiseReport:
+    """:func:`characterise` of a recording (its gyro, and its accelerometer when it has one).
+
+    Raw counts are refused: noise figures need a physical unit (give the sensitivity).
+    """
+    if rec.units != "rad/s":
+        raise UnitError("noise figures need physical units, but the gyro is in raw counts", param="sensitivity",
+                        hint="give {param} (LSB per output unit) so the counts become a rate")
+    accel = getattr(rec, "accel", None)
+    info = {"gyro_units": rec.source_units, **(source or {})}
+    if accel is not None:
+        info["accel_units"] = getattr(rec, "accel_source_units", None)
+    fs = rec.sample_rate
+    if rec.has_time and len(rec) > 1:
+        fs = (len(rec) - 1) / float(rec.t[-1] - rec.t[0])  # mean rate: bursty stamps average out
+    return characterise(rec.gyro, fs, accel=accel, motion=motion, level=level, source=info)

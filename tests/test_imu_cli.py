@@ -1,0 +1,192 @@
+"""``gyrocal imu`` from end to end: simulate a hand session, calibrate both sensors, apply, export.
+
+References: the truth sidecar of ``gyrocal simulate --protocol multi-position`` (independent of the
+fit), imucal's own loader and correction for the imucal export, and the C library for the header.
+"""
+
+import ctypes
+import json
+
+import numpy as np
+import pytest
+from cli_runner import invoke, refused
+
+from gyrocal import firmware
+from gyrocal.files import load
+from gyrocal.io import read_recording
+
+
+@pytest.fixture(scope="module")
+def session(tmp_path_factory):
+    """A simulated 20-pose session (deg/s, m/s^2) and its calibration file."""
+    d = tmp_path_factory.mktemp("imu")
+    rec = d / "hand.csv"
+    code, out, err = invoke("simulate", "--protocol", "multi-position", "-o", rec, "--poses", "20", "--still", "2.5",
+                            "--sample-rate", "100", "--noise", "0.002", "--misalignment", "1", "--k", "1.01,0.99,1.02",
+                            "--b", "0.01,-0.02,0.005", "--seed", "5")
+    assert code == 0, err
+    cal = d / "imu.json"
+    code, out, err = invoke("imu", rec, "--units", "deg/s", "--accel-units", "m/s^2", "-o", cal, "--plot",
+                            d / "poses.png")
+    assert code == 0, err
+    return rec, cal, out, d
+
+
+def test_prints_both_sensors_and_the_poses(session):
+    _, _, out, d = session
+    assert "20 still poses detected (20 distinct orientations), a multi-position session" in out
+    assert "accelerometer: triangular model" in out and "gyro: affine model" in out
+    assert "turns between poses: 19" in out
+    assert (d / "poses.png").stat().st_size > 10_000
+
+
+def test_file_recovers_the_simulated_truth_within_its_uncertainty(session):
+    """Reference: the truth sidecar. Both sensors' canonical corrections, entry by entry, within 4.5 sigma."""
+    rec, cal_path, _, _ = session
+    truth = json.loads(rec.with_name("hand.truth.json").read_text())
+    cal = load(cal_path)
+    part = cal.accelerometer
+    acc = np.array(part["parameters"]["values"])
+    names = part["parameters"]["names"]
+    true_a, true_o = np.array(truth["accelerometer"]["matrix"]), np.array(truth["accelerometer"]["offset"])
+    want = [true_a["xyz".index(n[2]), "xyz".index(n[3])] if n.startswith("A_") else true_o["xyz".index(n[2])]
+            for n in names]
+    std = np.array([part["std"][n] for n in names])
+    assert np.all(np.abs(acc - want) < 4.5 * std)
+    # gyro: w = matrix (raw - offset) in rad/s internally; the file's K = matrix^-1 (the full-temperature-range
+    # method's eq. 12) and its std are in the Kg order
+    true_k = np.linalg.inv(np.array(truth["gyro_correction"]["matrix"]))
+    kg = np.array(cal.model.kg)
+    from gyrocal.models import KG_INDEX
+
+    want_kg = np.concatenate([[true_k[r, c] for r, c in KG_INDEX], truth["gyro_correction"]["offset"]])
+    assert np.all(np.abs(kg - want_kg) < 4.5 * cal.std)
+
+
+def test_apply_corrects_accelerometer_and_gyro_by_default(session, tmp_path):
+    """Reference: at rest the corrected specific force has the local gravity's size (to its noise)."""
+    rec, cal_path, _, _ = session
+    out = tmp_path / "corrected.csv"
+    code, stdout, err = invoke("apply", cal_path, rec, "-o", out)
+    assert code == 0, err
+    corrected = read_recording(out, units="deg/s", accel_units="m/s^2")
+    truth = json.loads(rec.with_name("hand.truth.json").read_text())
+    a, b = truth["still"][3]
+    norm = np.linalg.norm(corrected.accel[a + 30:b - 30], axis=1).mean()
+    assert abs(norm - 9.80665) < 0.01  # pose mean of ~200 samples of 0.02 m/s^2 noise, plus 1e-3 calibration
+    assert np.abs(np.degrees(corrected.gyro[a + 30:b - 30]).mean(axis=0)).max() < 0.02  # bias removed
+
+
+def test_imucal_export_loads_in_imucal_and_corrects_the_same(session, tmp_path):
+    """Reference: imucal's own loader and correction (CalibrationInfo.from_json_file, calibrate)."""
+    from imucal import CalibrationInfo
+
+    rec, cal_path, _, _ = session
+    out = tmp_path / "imucal.json"
+    code, _, err = invoke("export", cal_path, "--format", "imucal", "-o", out)
+    assert code == 0, err
+    info = CalibrationInfo.from_json_file(out)
+    data = read_recording(rec, units="deg/s", accel_units="m/s^2")
+    acc, gyr = info.calibrate(data.accel, np.degrees(data.gyro), "m/s^2", "deg/s")
+    ours = load(cal_path).apply(data)
+    np.testing.assert_allclose(acc, ours.accel, atol=1e-10)
+    np.testing.assert_allclose(gyr, np.degrees(ours.gyro), atol=1e-9)
+
+
+def test_yaml_export_carries_the_accelerometer(session, tmp_path):
+    import yaml
+
+    _, cal_path, _, _ = session
+    code, out, err = invoke("export", cal_path, "--format", "yaml", "-o", tmp_path / "imu.yaml")
+    assert code == 0, err
+    doc = yaml.safe_load((tmp_path / "imu.yaml").read_text())
+    assert doc["accelerometer"]["correction"]["matrix"] == load(cal_path).accelerometer.to_document()["correction"][
+        "matrix"]
+
+
+def test_c_header_imu_table_matches_python(session, tmp_path):
+    """Reference: Python's Calibration.apply; the C library reads the exported header (float32)."""
+    rec, cal_path, _, _ = session
+    cal = load(cal_path)
+    header = tmp_path / "imu_cal.h"
+    header.write_text(cal.c_header())
+    src = tmp_path / "driver.c"
+    src.write_text('#include "imu_cal.h"\nint drive(const float g[3], const float a[3], float w[3], float f[3])\n'
+                   "{ return gyrocal_imu_correct(&GYROCAL_IMU, g, a, w, f); }\n")
+    dll = firmware.load_library(tmp_path / "build", extra_sources=[src], include_dirs=[tmp_path]).dll
+    data = read_recording(rec, units="deg/s", accel_units="m/s^2")
+    g_raw = np.ascontiguousarray(np.degrees(data.gyro[::97]), dtype=np.float32)
+    a_raw = np.ascontiguousarray(data.accel[::97], dtype=np.float32)
+    w, f = np.empty_like(g_raw), np.empty_like(a_raw)
+    ptr = ctypes.POINTER(ctypes.c_float)
+    for i in range(len(g_raw)):
+        assert dll.drive(*(x[i].ctypes.data_as(ptr) for x in (g_raw, a_raw, w, f))) == 0
+    ours = cal.apply(data)
+    eps = np.finfo(np.float32).eps
+    # float32: a few roundings of terms the size of the readings and offsets
+    np.testing.assert_allclose(f, ours.accel[::97], atol=40 * eps * 10.0)
+    np.testing.assert_allclose(w, np.degrees(ours.gyro[::97]), atol=40 * eps * 200.0)
+
+
+def test_ferraris_session_with_imucal_section_list(tmp_path):
+    """imucal's example (six faces and three turns): the accelerometer takes the box's frame."""
+    from importlib import resources
+
+    data = resources.files("gyrocal") / "data" / "imucal_ferraris"
+    out = tmp_path / "ferraris.json"
+    code, stdout, err = invoke("imu", data / "example_ferraris_session.csv", "--columns",
+                               "gx=gyr_x,gy=gyr_y,gz=gyr_z,ax=acc_x,ay=acc_y,az=acc_z", "--sample-rate", "102.4",
+                               "--units", "deg/s", "--accel-units", "m/s^2", "--gravity", "9.81", "--windows",
+                               data / "example_ferraris_session_list.json", "-o", out)
+    assert code == 0, err
+    assert "6 still poses from --windows (6 distinct orientations), a ferraris session" in stdout
+    cal = load(out)
+    assert cal.method == "ferraris" and cal.accelerometer["model"] == "affine"
+    assert "warning: accelerometer fit: residuals are" in err  # hand-placed faces: it says so
+
+
+def test_refusals_are_one_line(tmp_path):
+    code, _, err = invoke("simulate", "--protocol", "multi-position", "-o", tmp_path / "few.csv", "--poses", "4",
+                          "--sample-rate", "50", "--noise", "0.002")
+    assert code == 0, err
+    line = refused("imu", tmp_path / "few.csv", "--units", "deg/s", "--accel-units", "m/s^2")
+    assert "at least 6 distinct orientations" in line and "2 more orientation" in line
+    line = refused("imu", tmp_path / "few.csv", "--units", "deg/s")
+    assert "--accel-units is required" in line
+    gyro_only = tmp_path / "gyro.csv"
+    gyro_only.write_text("t,gx,gy,gz\n" + "".join(f"{i / 100},0.1,0.2,0.3\n" for i in range(500)))
+    line = refused("imu", gyro_only, "--units", "deg/s", "--accel-units", "m/s^2")
+    assert "accelerometer" in line
+
+
+def test_raw_counts_with_an_unsigned_offset_metadata_lines_and_no_header(tmp_path):
+    """A logger's file: three metadata lines, whitespace columns without names, raw unsigned 16-bit counts
+    around 32768 (131 LSB per deg/s, 16384 LSB per g). Reference: those sensitivities, which the fit does not
+    know and reports back."""
+    from gyrocal.models import Affine
+    from gyrocal.simulation.gyro import VirtualGyro
+    from gyrocal.simulation.multiposition import MultiPositionProtocol, VirtualImu, simulate_multi_position
+
+    rng = np.random.default_rng(12)
+    imu = VirtualImu(VirtualGyro(Affine(np.eye(3), np.radians([0.3, -0.2, 0.1])), noise_std=np.radians(0.05)),
+                     accel_noise_std=0.02)
+    s = simulate_multi_position(imu, MultiPositionProtocol(poses=16, static_duration=(2.0, 3.0), uneven_steps=0.01),
+                                rng=rng)
+    g = np.clip(np.round(np.degrees(s.gyro) * 131.0 + 32768), 0, 65535).astype(int)
+    a = np.clip(np.round(s.accel / 9.80665 * 16384.0 + 32768), 0, 65535).astype(int)
+    path = tmp_path / "logger.txt"
+    lines = ["# logger v1.2", "# board MPU-6050", "# 100 Hz"]
+    lines += [f"{t:.4f} " + " ".join(str(v) for v in (*gi, *ai)) for t, gi, ai in zip(s.t, g, a)]
+    path.write_text("\n".join(lines) + "\n")
+    out = tmp_path / "cal.json"
+    code, stdout, err = invoke("imu", path, "--skip-rows", "3", "--columns", "t=1,gx=2,gy=3,gz=4,ax=5,ay=6,az=7",
+                               "--units", "counts", "--accel-units", "counts", "-o", out)
+    assert code == 0, err
+    assert "nearest setting: ±250 °/s (131 LSB)" in stdout and "nearest setting: ±2 g (16384 LSB)" in stdout
+    cal = load(out)
+    # gyro: rad/s per count; the truth is 1/131 deg/s per count on every axis
+    k = np.diag(cal.model.matrix)  # the affine model's K^-1 [rad/s per count]
+    std_k = cal.std[:3] * k**2  # Kxx, Kyy, Kzz first in the Kg order; d(1/K) = -dK / K^2
+    assert np.all(np.abs(k - np.radians(1 / 131.0)) < 4.5 * std_k)
+    offset = np.array(cal.accelerometer["correction"]["offset"])
+    assert np.all(np.abs(offset - 32768) < 4.5 * np.array([cal.accelerometer["std"][f"o_{c}"] for c in "xyz"]))
