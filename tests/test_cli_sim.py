@@ -1,4 +1,8 @@
-"""The ``simulate``, ``noise``, ``plan`` and ``study`` commands, in-process and once as a subprocess."""
+"""The ``simulate``, ``noise``, ``plan`` and ``study`` commands, in-process and once as a subprocess.
+
+References: the truth sidecar (the simulator's own parameters) against what calibrate recovers, and the
+numbers of samples, rates and temperatures the flags ask for.
+"""
 
 import json
 import math

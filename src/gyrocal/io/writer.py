@@ -97,6 +97,7 @@ def _arrow_chunk_writer():
         text_columns = [table.column(k) for k, v in chunk.items() if v.dtype.kind not in "fiub"]
         quote = any(pc.any(pc.match_substring_regex(c, _NEEDS_QUOTES)).as_py() for c in text_columns)
         pcsv.write_csv(table, f, pcsv.WriteOptions(include_header=False, quoting_style="needed" if quote else "none"))
+        pa.default_memory_pool().release_unused()  # the formatted chunk: do not let the allocator keep it
 
     return write
 
