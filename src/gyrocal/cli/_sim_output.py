@@ -4,9 +4,31 @@ large sessions (a paper-size turntable session is 7.6 M samples, about 600 MB of
 from __future__ import annotations
 
 from ..errors import InputError
+from ._options import in_unit, triple_in_unit
 from ._sim_runs import turntable_protocol
 
-__all__ = ["announce", "as_counts", "output_unit", "writing_bar"]
+__all__ = ["announce", "as_counts", "output_unit", "rate_flags", "write_output", "writing_bar"]
+
+
+def rate_flags(speed, noise, bias_instability, rate_random_walk, quantum, full_scale, b):
+    """The rate flags as numbers in the unit each names (speed, full scale deg/s; the rest rad/s); a number
+    written with another unit (2deg/s, 0.035rad/s) is converted to it."""
+    return (60.0 if speed is None else in_unit("--speed", speed, "deg/s"), in_unit("--noise", noise, "rad/s"),
+            in_unit("--bias-instability", bias_instability, "rad/s") or 0.0,
+            in_unit("--rrw", rate_random_walk, "rad/s") or 0.0, in_unit("--quantum", quantum, "rad/s"),
+            in_unit("--full-scale", full_scale, "deg/s"), triple_in_unit("--b", b, "rad/s", (0.0, 0.0, 0.0)))
+
+
+def write_output(output, rec, unit: str, sensitivity: float | None, settings: dict, what: str, *, large: bool) -> None:
+    """Write the simulated recording in `unit` (counts through the sensitivity), with a bar when `large`."""
+    from ..io import write_recording
+
+    if unit == "counts":
+        rec = as_counts(rec, sensitivity)
+        settings["sensitivity_lsb_per_deg_s"] = sensitivity
+    note = f"{what}; gyro in {unit}" + (f" ({sensitivity:g} LSB per deg/s)" if unit == "counts" else "") + ", t in s"
+    with writing_bar(len(rec) if large else None) as advance:
+        write_recording(output, rec, units=unit, header_comment=note, progress=advance)
 
 
 def output_unit(units: str, sensitivity: float | None) -> str:

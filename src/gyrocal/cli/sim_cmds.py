@@ -14,9 +14,9 @@ import typer
 
 from ..choices import DeviceWire, Protocol, TimeStamps
 from ..errors import InputError
-from ._options import NoiseDensity, given, in_unit, noise_std, numbers, refuse_unused, triple, triple_in_unit
+from ._options import NoiseDensity, given, noise_std, numbers, refuse_unused, triple
 from ._outputs import check_output, json_format, starts_with
-from ._sim_output import announce, as_counts, output_unit, writing_bar
+from ._sim_output import announce, output_unit, rate_flags, write_output
 from ._sim_runs import multi_position, profile_run, turntable, turntable_protocol
 from .app import app, console
 
@@ -178,22 +178,15 @@ def simulate(
     from ..units import parse_rate_unit
 
     refuse_unused(ctx, _PROTOCOL_FLAGS, protocol, "--protocol")
-    # each rate flag names its unit; a number written with another unit is converted to it
-    speed = 60.0 if speed is None else in_unit("--speed", speed, "deg/s")
-    noise = in_unit("--noise", noise, "rad/s")
-    bias_instability = in_unit("--bias-instability", bias_instability, "rad/s") or 0.0
-    rate_random_walk = in_unit("--rrw", rate_random_walk, "rad/s") or 0.0
-    quantum, full_scale = in_unit("--quantum", quantum, "rad/s"), in_unit("--full-scale", full_scale, "deg/s")
-    b = triple_in_unit("--b", b, "rad/s", (0.0, 0.0, 0.0))
+    speed, noise, bias_instability, rate_random_walk, quantum, full_scale, b = rate_flags(
+        speed, noise, bias_instability, rate_random_walk, quantum, full_scale, b)
     _refuse_reference_flags(ctx, reference)
     if device and reference is not None:
         raise InputError("--reference writes a second log; it does not go with --device (leave one out)")
     if device:
         return _serve_device(protocol, speed, turns, wait, misalignment, k, b, noise, noise_density, sample_rate,
                              seed, wire, faults, pace)
-    for name in ("wire", "faults", "pace"):
-        if given(ctx, name):
-            raise InputError(f"--{name} is for --device only; add --device or leave --{name} out")
+    _refuse_device_flags(ctx)
     truth_file = _check_outputs(output, truth_path(output) if output else None, reference, profile, force)
     unit = output_unit(units, sensitivity)
     rng = np.random.default_rng(seed)
@@ -226,13 +219,7 @@ def simulate(
                                                      noise=ref_noise)
     if stamps == "receive" or gaps or given(ctx, "late_per_minute"):
         rec, facts = _time_defects(rec, facts, settings, stamps, late_per_minute, gaps, gap_length, reference, rng)
-    if unit == "counts":
-        rec = as_counts(rec, sensitivity)
-        settings["sensitivity_lsb_per_deg_s"] = sensitivity
-    note = f"{_SIMULATED} --protocol {protocol}; gyro in {unit}" + (
-        f" ({sensitivity:g} LSB per deg/s)" if unit == "counts" else "") + ", t in s"
-    with writing_bar(len(rec) if size else None) as advance:
-        write_recording(output, rec, units=unit, header_comment=note, progress=advance)
+    write_output(output, rec, unit, sensitivity, settings, f"{_SIMULATED} --protocol {protocol}", large=bool(size))
     if ref_rec is not None:
         ref_unit = parse_rate_unit(ref_units, "ref_units")
         write_recording(reference, ref_rec, units=ref_unit,
@@ -258,6 +245,13 @@ def _check_outputs(output: Path | None, truth_file: Path | None, reference: Path
         check_output(reference, flag="--reference", inputs=(profile, output, truth_file), force=force,
                      replaceable=starts_with(f"# {_SIMULATED}"))
     return truth_file
+
+
+def _refuse_device_flags(ctx: typer.Context) -> None:
+    """--wire, --faults and --pace describe a served device: refuse them without --device."""
+    for name in ("wire", "faults", "pace"):
+        if given(ctx, name):
+            raise InputError(f"--{name} is for --device only; add --device or leave --{name} out")
 
 
 def _refuse_reference_flags(ctx: typer.Context, reference: Path | None) -> None:
