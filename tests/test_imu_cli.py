@@ -233,3 +233,13 @@ def test_accelerometer_log_on_other_stamps_is_interpolated_onto_the_gyro(tmp_pat
     acc.write_text("".join(f"{x:.4f} 0 0 1\n" for x in ta[:300]))
     with pytest.raises(InputError, match="share less than half the session"):
         attach_accelerometer(rec, acc, accel_units="g", columns="t=1,ax=2,ay=3,az=4")
+
+
+def test_a_wrong_declared_unit_is_pointed_out(session, tmp_path):
+    """deg/s data declared as rad/s and m/s^2 data declared as g: the fit still closes, with scale factors near
+    1/57.3 and 1/9.8, and a warning names each unit."""
+    rec, _, _, _ = session
+    code, _, err = invoke("imu", rec, "--units", "rad/s", "--no-unit-check", "--accel-units", "g")
+    assert code == 0, err
+    assert "is the gyro's unit right? (57.3: deg/s read as rad/s)" in err
+    assert "is --accel-units g right? (9.8: g read as m/s^2)" in err

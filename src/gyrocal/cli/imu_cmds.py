@@ -222,7 +222,7 @@ def imu(
     _print_poses(run)
     _print_accel(run)
     _print_gyro(run)
-    for line in run.result.warnings:
+    for line in run.warnings:
         warn(line)
     if output is not None:
         console.print(f"wrote {output}" + (f" and {plot}" if plot is not None else ""), highlight=False)
