@@ -15,6 +15,9 @@ FLAGS: dict[str, str] = {
     "units": "--units",
     "columns": "--columns",
     "skip_rows": "--skip-rows",
+    # plan
+    "target_scale": "--target-scale",
+    "target_bias": "--target-bias",
     "sample_rate": "--sample-rate",
     "sensitivity": "--sensitivity",
     "output_units": "--output-units",

@@ -375,7 +375,7 @@ def segments(
         from ..plotting import save_figure
         from ..plotting.calibration import calibration_figure
 
-        save_figure(calibration_figure(rec, found, title=f"{recording.name}: windows {source}"), plot)
+        save_figure(calibration_figure(rec, found, title=f"{recording.name}: windows {source}", ignored=ignored), plot)
         console.print(f"wrote {plot}", highlight=False)
 
 

@@ -87,6 +87,7 @@ def plan(
 ) -> None:
     """Predict each parameter's std and the protocol time; suggest the fastest protocol for a target."""
     import numpy as np
+    from rich.markup import escape
     from rich.table import Table
 
     refuse_unused(ctx, _DESIGN_FLAGS, design, "--design")
@@ -104,25 +105,54 @@ def plan(
     density = noise_std(noise, noise_density, sample_rate, 0.035) / math.sqrt(sample_rate)
     model = ScaleBias(np.asarray(triple("--k", k, (1.0, 1.0, 1.0))), np.zeros(3))
     options = dict(sample_rate=sample_rate, noise_density=density, model=model, static_duration=wait, pause=wait)
-    plans = [("as given", predict(design, speed=math.radians(speed), revolutions=revolutions, **options))]
+    given = predict(design, speed=math.radians(speed), revolutions=revolutions, **options)
+    plans = [("as given", given)]
     bias_target = _rate_arg("--target-bias", target_bias, "rad/s")
+    verdict = None
     if target_scale is not None or bias_target is not None:
         best = suggest(target_scale=target_scale, target_bias=bias_target, max_speed=math.radians(max_speed),
-                       design=design, **options)
-        if best is None:
-            console.print(f"no protocol up to {max_speed:g} deg/s and 20 revolutions per turn reaches the target")
-        else:
+                       design=design, baseline=given, **options)
+        verdict = _verdict(given, best, target_scale, bias_target, max_speed)
+        if best is not None:
             plans.append(("suggested", best))
-    table = Table(title=f"Cramer-Rao prediction, design {design}, {sample_rate:g} Hz, "
-                        f"noise density {density.mean():.3g} rad/s/sqrt(Hz)")
-    for col in ("protocol", "speed (deg/s)", "revolutions", "time (s)", "std kx, ky, kz (1e-4)",
-                "std bx, by, bz (deg/s)"):
-        table.add_column(col, justify="right")
+    console.print(f"Cramer-Rao prediction, design {design}, {sample_rate:g} Hz, noise density "
+                  f"{density.mean():.3g} rad/s/sqrt(Hz)", highlight=False, soft_wrap=True)
+    table = Table()
+    for col in ("protocol", "speed\n[deg/s]", "revolutions", "time\n[s]", "std k\n[1e-4]", "std b\n[deg/s]"):
+        table.add_column(escape(col), justify="right", no_wrap=True)
     for label, p in plans:
         table.add_row(label, f"{math.degrees(p.speed):.1f}", f"{p.revolutions:g}", f"{p.total_time:.1f}",
-                      ", ".join(f"{1e4 * v:.3g}" for v in p.std[:3]),
-                      ", ".join(f"{math.degrees(v):.3g}" for v in p.std[3:]))
+                      _per_axis(1e4 * p.std[:3]), _per_axis(np.degrees(p.std[3:])))
     console.print(table)
+    if verdict is not None:
+        console.print(verdict, highlight=False, soft_wrap=True)
+
+
+def _per_axis(values) -> str:
+    """One figure when the three axes agree (a symmetric design), else x/y/z."""
+    shown = [f"{v:.3g}" for v in values]
+    return shown[0] if len(set(shown)) == 1 else "/".join(shown)
+
+
+def _verdict(given, best, target_scale, target_bias, max_speed: float) -> str:
+    """What the targets mean for the protocol as given, and what the suggestion is."""
+    parts = []
+    if target_scale is not None:
+        parts.append(f"std k <= {target_scale:.3g}")
+    if target_bias is not None:
+        parts.append(f"std b <= {math.degrees(target_bias):.3g} deg/s")
+    target = "target " + " and ".join(parts)
+    if given.meets(target_scale, target_bias):
+        if best is None:
+            return (f"the protocol as given already meets the {target}; no shorter protocol up to {max_speed:g} "
+                    "deg/s meets it without a larger std on a target")
+        return (f"the protocol as given already meets the {target}; the suggestion meets it too, "
+                f"{given.total_time - best.total_time:.1f} s shorter, with no larger std on a target")
+    if best is None:
+        return (f"the protocol as given misses the {target}, and no protocol up to {max_speed:g} deg/s and "
+                "20 revolutions per turn reaches it")
+    return (f"the protocol as given misses the {target}; the suggestion is the shortest protocol up to "
+            f"{max_speed:g} deg/s that reaches it without a larger std on a target")
 
 
 def _plan_poses(poses, tilt, still, peak_rate, sample_rate, accel_density, gyro_density, targets) -> None:
