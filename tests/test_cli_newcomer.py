@@ -372,3 +372,19 @@ def test_a_large_session_says_its_size_first(tmp_path):
     estimate = float(first.split("about ")[1].split(" MB")[0])
     actual = (tmp_path / "s.csv").stat().st_size / 1e6
     assert 0.7 < estimate / actual < 1.4, (estimate, actual)
+
+
+def test_skip_rows_reaches_noise_and_thermal(tmp_path):
+    code, _, err = invoke("simulate", "-o", tmp_path / "still.csv", "--protocol", "static", "--duration", "60")
+    assert code == 0, err
+    lines = [line for line in (tmp_path / "still.csv").read_text().splitlines() if not line.startswith("#")]
+    pre = tmp_path / "pre.csv"
+    width = len(lines[0].split(","))  # a preamble as wide as the table: only the user knows where it ends
+    pre.write_text(",".join(["sensor"] + ["x"] * (width - 1)) + "\n" + ",".join(map(str, range(width))) + "\n"
+                   + "\n".join(lines) + "\n")
+    assert "--skip-rows N" in refused("noise", pre, "--units", "deg/s")
+    code, out, err = invoke("noise", pre, "--units", "deg/s", "--skip-rows", "2")
+    assert code == 0, err
+    for command in ("thermal", "thermal-report"):
+        code, out, _ = invoke(command, "--help")
+        assert code == 0 and "--skip-rows" in out
