@@ -1,4 +1,7 @@
-"""The calibration picture, checked through its artists (no pyplot state)."""
+"""The calibration picture, checked through its artists (no pyplot state).
+
+References: the figure's own artists (lines, spans and labels) against the recording and windows drawn.
+"""
 
 import math
 
