@@ -199,3 +199,10 @@ def test_bundled_example_verifies_against_its_truth(tmp_path):
     assert abs(a.clock_drift_ppm - ref["clock_drift_ppm"]) < 4 * a.std[1]
     assert abs(a.rotation_deg - ref["mounting_rotation_deg"]) < 4 * a.rotation_deg_std
     assert "not both" in refused("verify", tmp_path / "cal.json", "x.csv", "--example", "-o", tmp_path / "o2")
+
+
+def test_reference_reading_errors_name_the_ref_flags(bench, tmp_path):
+    """A reference in deg/s declared as rad/s: the reader's hint names --ref-units and --ref-no-unit-check."""
+    folder, _ = bench
+    line = refused(*_verify_args(folder, "--ref-units", "rad/s"))
+    assert "use --ref-units deg/s (or --ref-no-unit-check)" in line

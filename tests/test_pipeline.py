@@ -1,4 +1,8 @@
-"""The calibration pipeline: simulated sessions come back within their predicted uncertainty."""
+"""The calibration pipeline: simulated sessions come back within their predicted uncertainty.
+
+References: the simulated truth (within 4 predicted sigma) and the spread over 40 seeds against the
+predicted sigma.
+"""
 
 import dataclasses
 import math

@@ -219,12 +219,14 @@ class AccelerometerPart(Section):
 
     Documented keys: ``units`` ``{input, output, sensitivity, gravity}``, ``correction``
     ``{matrix (3, 3), offset (3,)}`` with ``a_true = matrix @ (raw - offset)`` in those units,
-    ``parameters``, ``std``, ``covariance``, ``fit``.
+    ``parameters``, ``std``, ``covariance``, ``fit``, ``gyro_g_sensitivity`` (null or ``{matrix (3, 3)}``
+    [gyro input units per m/s^2]: the gyro correction becomes ``matrix @ (raw - offset - G a_true)``).
+    The whole-IMU calibration (:mod:`gyrocal.imu.filedoc`) adds ``model``, ``sensor_axes``, ``poses``.
     """
 
     NAME = "accelerometer"
     FIELDS = {"units": obj, "correction": obj, "parameters": obj, "std": obj, "covariance": numbers((-1, -1)),
-              "fit": obj}
+              "fit": obj, "gyro_g_sensitivity": obj}
 
     @classmethod
     def _problem(cls, frozen: Mapping[str, Any]) -> tuple[str, str] | None:
@@ -236,6 +238,12 @@ class AccelerometerPart(Section):
                     numbers(shape)(corr.get(key))
                 except ValueError as exc:
                     return f"correction.{key}", str(exc)
+        coupling = frozen.get("gyro_g_sensitivity")
+        if problem is None and coupling is not None:
+            try:
+                numbers((3, 3))(coupling.get("matrix"))
+            except ValueError as exc:
+                return "gyro_g_sensitivity.matrix", str(exc)
         return problem
 
     def apply_to(self, rec) -> dict[str, Any]:
@@ -262,6 +270,17 @@ class AccelerometerPart(Section):
         matrix, offset = np.asarray(_thaw(corr["matrix"]), float), np.asarray(_thaw(corr["offset"]), float)
         return {"accel": ((raw - offset) @ matrix.T) * factor[u_out], "accel_units": "m/s^2",
                 "accel_source_units": u_out, "accel_sensitivity": None}
+
+    def gyro_coupling(self, accel_true) -> np.ndarray | None:
+        """The gyro's g-sensitivity term ``G a_true`` (N, 3) [gyro input units], or None without one.
+
+        `accel_true` is the corrected specific force [m/s^2] (``apply_to(rec)["accel"]``); the gyro
+        correction then reads ``w_true = matrix @ (raw - offset - G a_true)``.
+        """
+        g = self.get("gyro_g_sensitivity")
+        if g is None or accel_true is None:
+            return None
+        return np.asarray(accel_true, dtype=float) @ np.asarray(_thaw(g["matrix"]), dtype=float).T
 
 
 def section(cls: type[Section], value: Any) -> Section | None:

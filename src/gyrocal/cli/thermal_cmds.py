@@ -167,7 +167,7 @@ def thermal_report(
 
     table = Table(title=escape(f"RMS error [{cal.output_units}] per rotating axis / gyro axis"))
     for col in ("rot", "gyro", "uncomp.", "traditional", "lagrange", "smooth", "lagrange cut"):
-        table.add_column(col, justify="right")
+        table.add_column(col, justify="right", no_wrap=True)
     for r in ev.summary(cal.output_units):
         table.add_row(r["rotating_axis"], r["gyro_axis"], *(f"{r[m + '_rms']:.4g}" for m in
                       ("uncompensated", "traditional", "lagrange", "smooth")), f"{r['lagrange_rms_reduction_pct']:.1f} %")

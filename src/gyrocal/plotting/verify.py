@@ -13,7 +13,7 @@ import numpy as np
 
 from ..errors import InputError
 from .calibration import AXIS_COLORS
-from .figure import new_figure
+from .figure import new_figure, outside_legend
 
 __all__ = ["default_stretch", "error_figure", "overlay_figure", "plot_errors", "plot_overlay"]
 
@@ -66,7 +66,7 @@ def plot_overlay(ax, t, test, reference, axis: int, *, units: str, label: str = 
     gyro, = ax.plot(t[w], test[w, axis], color=AXIS_COLORS[axis], lw=0.8, label=f"{label} {_AXES[axis]}")
     ref, = ax.plot(t[w], reference[w, axis], color="black", lw=0.8, ls="--", label=f"reference {_AXES[axis]}")
     ax.set_ylabel(f"{_AXES[axis]} [{units}]")
-    ax.legend(loc="upper right", fontsize=8)
+    outside_legend(ax)
     return [gyro, ref]
 
 
@@ -97,7 +97,7 @@ def plot_errors(ax, t, before, after, axis: int, *, units: str, stretch=None, sm
                       label=f"{label}, {smooth_s:g} s mean", **style["mean"])[0] for err, label, style in drawn]
     ax.axhline(0.0, color="black", lw=0.5)
     ax.set_ylabel(f"error {_AXES[axis]} [{units}]")
-    ax.legend(loc="upper right", fontsize=7, ncol=2)
+    outside_legend(ax, fontsize=7)
     return lines
 
 
