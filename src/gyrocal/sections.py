@@ -174,10 +174,12 @@ class Section(Mapping):
 
 
 def _residuals(v):
-    """Residuals in noise units: numbers, or one list of numbers per window (of any length)."""
-    if isinstance(v, tuple) and all(isinstance(z, tuple) for z in v):
-        for z in v:  # plain Python: thousands of windows, a few numbers each
-            if not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in z):
+    """Residuals in noise units: numbers, one list of numbers per window (of any length), or one
+    ``{"window", "label", "z": [numbers]}`` object per window."""
+    if isinstance(v, tuple) and v and all(isinstance(z, (tuple, Mapping)) for z in v):
+        for r in v:  # plain Python: thousands of windows, a few numbers each
+            z = r.get("z", ()) if isinstance(r, Mapping) else r
+            if not isinstance(z, tuple) or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in z):
                 raise ValueError(f"must hold numbers in every window, got {_thaw(z)!r}")
         return v
     return numbers((-1,))(v)
