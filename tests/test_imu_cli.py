@@ -243,3 +243,23 @@ def test_a_wrong_declared_unit_is_pointed_out(session, tmp_path):
     assert code == 0, err
     assert "is the gyro's unit right? (57.3: deg/s read as rad/s)" in err
     assert "is --accel-units g right? (9.8: g read as m/s^2)" in err
+
+
+def test_g_sensitivity_flag_and_its_place_in_the_file(session, tmp_path):
+    """The simulated gyro has no g-sensitivity: the fitted one is zero within its 1-sigma (4.5 sigma), and the
+    file carries it where apply and the exports find it."""
+    rec, _, _, _ = session
+    out = tmp_path / "g.json"
+    code, stdout, err = invoke("imu", rec, "--units", "deg/s", "--accel-units", "m/s^2", "--g-sensitivity", "-o", out)
+    assert code == 0, err
+    assert "g-sensitivity: fitted from the still poses" in stdout
+    part = load(out).accelerometer["gyro_g_sensitivity"]
+    g, std = np.array(part["matrix"]), np.array(part["std"])
+    assert part["units"] == "deg/s per m/s^2" and np.all(np.abs(g) < 4.5 * std)
+
+
+def test_imucal_export_needs_both_sensors(tmp_path):
+    code, _, err = invoke("calibrate", "--example", "-o", tmp_path / "gyro.json")
+    assert code == 0, err
+    line = refused("export", tmp_path / "gyro.json", "--format", "imucal", "-o", tmp_path / "x.json")
+    assert "imucal's format holds the accelerometer and the gyro" in line and "gyrocal imu" in line
