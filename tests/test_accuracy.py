@@ -2,6 +2,9 @@
 
 2,000 seeded gyros: k ~ U(0.8, 1.2), b ~ U(-0.1, 0.1) rad/s, 200 Hz, 60 deg/s, 0.035 rad/s
 noise, 5 % speed jitter, tilts up to 0.1 rad, one revolution per window.
+
+References: the simulated truth (2,000 gyros), the Cramer-Rao bound of the design, and the predicted
+bias of the mean-of-squares form worked out in docs/core.md.
 """
 
 import math

@@ -1,4 +1,8 @@
-"""Atomic output: a failed write leaves the old file and no temporary; a new file gets normal permissions."""
+"""Atomic output: a failed write leaves the old file and no temporary; a new file gets normal permissions.
+
+References: the file system itself (contents, modes, names left behind) and a real process killed by
+SIGTERM.
+"""
 
 import os
 import stat

@@ -18,7 +18,7 @@ import pytest
 
 from gyrocal import firmware
 from gyrocal.capture import frames as fr
-from gyrocal.capture.agreement import C_ROUND, EPS32, check_device
+from gyrocal.capture.agreement import check_device, corrected_bound
 from gyrocal.capture.c_device import CDevice
 from gyrocal.capture.simulated import simulate_device_session
 from gyrocal.estimators import FirstMoment
@@ -135,6 +135,25 @@ def test_calibrated_samples_are_the_device_correction(session, sent):
     k, b = np.array(result.k, float), np.array(result.b, float)
     m = session.raw[result.seq:].astype(float)
     w = np.array([c.w for c in cal])
-    # gyrocal_correct: one subtraction and one multiply-add chain per axis, in float32
-    tol = C_ROUND * EPS32 * np.abs(k) * (np.abs(m) + np.abs(b))
-    assert np.all(np.abs(w - k * (m + b)) <= tol)
+    # gyrocal_correct: one subtraction and one product per axis, in float32
+    assert np.all(np.abs(w - k * (m + b)) <= corrected_bound(k, b, m))
+    # the check can fail: a correction off by a thousandth of a count on one axis
+    assert not check_device({t.slot: t for t in by_type(frames, fr.Turn) if t.status == 0}, result, None,
+                            (m, w + np.array([0.0, 0.0, k[2] * 1e-3]))).agrees
+
+
+def test_a_device_that_computes_otherwise_is_caught(session, sent):
+    """The check can fail: k off by 1e-5 relative, or one turn mean off by a tenth of a count, is far beyond
+    float32 rounding (about 1e-7 relative), so the device no longer agrees with the host."""
+    import dataclasses
+
+    frames = fr.FrameDecoder().feed(sent)
+    (result,) = by_type(frames, fr.Result)
+    latest = {t.slot: t for t in by_type(frames, fr.Turn) if t.status == 0}
+    samples = {s: session.raw[t.start: t.stop].astype(float) for s, t in latest.items()}
+    k = (result.k[0] * (1 + 1e-5), *result.k[1:])
+    assert not check_device(latest, dataclasses.replace(result, k=k), samples).agrees
+    moved = dict(latest)
+    moved[2] = dataclasses.replace(latest[2], mean=(latest[2].mean[0] + 0.1, *latest[2].mean[1:]))
+    agreement = check_device(moved, result, samples)
+    assert agreement.means_ratio > 1 and not agreement.agrees

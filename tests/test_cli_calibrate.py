@@ -1,6 +1,9 @@
 """The ``calibrate``, ``segments``, ``apply`` and ``export`` commands, in-process and once as a subprocess.
 
 In-process runs use :mod:`cli_runner` (the real error boundary inside typer's isolation).
+
+References: the simulated truth of each recording (within 4 predicted sigma), a 200-seed Monte Carlo
+for the printed 1-sigma, and the files and lines the commands write.
 """
 
 import json

@@ -218,3 +218,18 @@ def test_simulate_device_serves_capture(tmp_path):
 def test_simulate_device_flags_need_device(tmp_path):
     assert "--device" in refused("simulate", "-o", tmp_path / "r.csv", "--faults", "drop=0.1")
     assert "not understood" in refused("simulate", "--device", "--faults", "melt=1")
+
+
+def test_capture_warns_when_the_device_result_is_off(tmp_path, servo):
+    """A RESULT frame with k off by 1e-5 (a valid CRC: a firmware bug, not a line fault) is flagged."""
+    import dataclasses
+
+    data = device_bytes(servo, "frames", encoder="c")
+    frames = fr.FrameDecoder().feed(data)
+    (result,) = [f for f in frames if isinstance(f, fr.Result)]
+    bad = dataclasses.replace(result, k=(result.k[0] * (1 + 1e-5), *result.k[1:]))
+    data = data.replace(fr.encode(result), fr.encode(bad))
+    with VirtualDevice(data) as dev:
+        code, stdout, err = start(dev, "-o", tmp_path / "rec.csv").finish()
+    assert code == 0 and "device and host DISAGREE" in stdout
+    assert "warning: the device's calibration differs" in err

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import json
 import math
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -220,3 +222,169 @@ def test_units_show_their_choices():
         assert code == 0 and "--units <rad/s|deg/s|counts>" in out, command
     code, out, _ = invoke("calibrate", "--help")
     assert "(required)" in " ".join(out.split())
+
+
+# ---------------------------------------------------------------- what was found instead of the turns
+
+
+def test_no_rotation_says_what_was_measured_and_the_likely_fix(session, tmp_path):
+    """Reference: the session's turns are 360 deg at 60 deg/s, 200 Hz, in deg/s (as simulated)."""
+    cases = [
+        (("rad.csv", "--units", "deg/s", "--angle", "360", "--no-unit-check"),
+         "are the data in rad/s? (--units rad/s)"),
+        (("rad.csv", "--units", "deg/s", "--speed", "60", "--no-unit-check"), "are the data in rad/s? (--units rad/s)"),
+        (("deg.csv", "--units", "deg/s", "--angle", "36"), "were the turns 360 deg (--angle 360)?"),
+        # the raw plateau level is k times the speed: 60 deg/s reads 59.5-60.3
+        (("deg.csv", "--units", "deg/s", "--speed", "6"), re.compile(r"was the speed 60(\.\d)? deg/s \(--speed 60")),
+    ]
+    for args, fix in cases:
+        line = refused("calibrate", session / args[0], *args[1:])
+        assert "the turns left out measure +x" in line and "most likely: every" in line, line
+        assert (fix.search(line) if isinstance(fix, re.Pattern) else fix in line), line
+    # a wrong sample rate on a log without a time column: the rate that explains the turns is named
+    lines = (session / "deg.csv").read_text().splitlines()
+    bare = tmp_path / "g.csv"
+    bare.write_text("gx,gy,gz\n" + "\n".join(line.split(",", 1)[1] for line in lines[2:]) + "\n")
+    line = refused("calibrate", bare, "--units", "deg/s", "--sample-rate", "1000")
+    assert re.search(r"is the sample rate 20\d Hz \(--sample-rate 20\d\)\?", line), line
+    # turns about two axes only
+    code, _, err = invoke("simulate", "-o", tmp_path / "two.csv", "--turns", "+x,-x,+y,-y")
+    assert code == 0, err
+    line = refused("calibrate", tmp_path / "two.csv", "--units", "deg/s")
+    assert "no rotation about z" in line and "turn about the missing axes too" in line
+
+
+# ---------------------------------------------------------------- plan
+
+
+def test_plan_says_when_the_protocol_as_given_meets_the_target_and_never_worsens_it():
+    """Reference: the Cramer-Rao prediction of the protocol as given (the first row), computed by predict()."""
+    import math
+
+    from gyrocal.planning import predict
+
+    given = predict("six", speed=math.radians(60), noise_density=0.035 / math.sqrt(200.0))
+    code, out, _ = invoke("plan", "--target-bias", "0.05deg/s")
+    flat = " ".join(out.split())
+    assert code == 0 and "the protocol as given already meets the target std b <= 0.05 deg/s" in flat
+    assert "suggested" not in out  # every shorter protocol on the grid has a larger bias std
+    assert given.max_bias_std < math.radians(0.05)
+    code, out, _ = invoke("plan", "--target-scale", "1e-3")
+    rows = {cells[1]: cells for line in out.splitlines()
+            if len(cells := [c.strip() for c in line.split("\u2502")]) > 6 and cells[1] in ("as given", "suggested")}
+    k_given, k_suggested = (float(rows[key][5]) for key in ("as given", "suggested"))
+    assert k_suggested <= k_given and "already meets the target std k <= 0.001" in " ".join(out.split())
+    code, out, _ = invoke("plan", "--target-bias", "0.01deg/s")
+    assert code == 0 and "misses the target" in " ".join(out.split()) and "suggested" in out
+
+
+def test_sigterm_during_simulate_leaves_no_partial_output(tmp_path):
+    """A real 'gyrocal simulate' of a long static log, stopped by SIGTERM once its temporary file exists:
+    no .tmp is left and no output appears (the reference: the folder as it was before the run)."""
+    import shutil
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    exe = shutil.which("gyrocal", path=str(Path(sys.executable).parent))
+    out = tmp_path / "long.csv"
+    proc = subprocess.Popen([exe, "simulate", "-o", str(out), "--protocol", "static", "--duration", "20000",
+                             "--sample-rate", "200"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 120
+        while not any(p.name.endswith(".tmp.csv") for p in tmp_path.iterdir()):
+            assert proc.poll() is None and time.monotonic() < deadline, "the writer never started"
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGTERM)
+        assert proc.wait(timeout=60) == -signal.SIGTERM
+    finally:
+        proc.kill()
+        proc.stderr.close()
+    assert list(tmp_path.iterdir()) == []
+
+
+# ---------------------------------------------------------------- plots
+
+
+def test_segments_plot_marks_ignored_turns_and_nothing_covers_the_data(session, tmp_path):
+    """Drawn into a Figure and checked artist by artist: each ignored turn hatched with its reason, the
+    legend right of the axes, no offset text above them (epoch stamps), time counted from the start."""
+    from gyrocal.io import read_recording
+    from gyrocal.plotting.calibration import calibration_figure
+    from gyrocal.plotting.figure import plain_ticks
+    from gyrocal.segmentation import segment
+
+    lines = (session / "deg.csv").read_text().splitlines()
+    cells = [line.split(",", 1) for line in lines[2:]]
+    epoch = tmp_path / "epoch.csv"
+    epoch.write_text("t,gx,gy,gz\n" + "\n".join(f"{1.7e9 + float(t)!r},{rest}" for t, rest in cells) + "\n")
+    rec = read_recording(epoch, units="deg/s")
+    seg = segment(rec, reference="angle", angle=math.pi / 2, require=False)  # 360 deg turns declared as 90
+    fig = calibration_figure(rec, list(seg.windows), ignored=list(seg.ignored))
+    ax = fig.axes[0]
+    reasons = [t.get_text() for t in ax.texts if t.get_text().startswith("ignored:")]
+    assert len(reasons) == 6 and all(r == "ignored: wrong angle" for r in reasons)
+    assert sum(p.get_hatch() == "///" for p in ax.patches) == 6
+    legend = ax.get_legend()
+    assert legend.get_bbox_to_anchor().transformed(ax.transAxes.inverted()).x0 >= 1.0
+    plain_ticks(fig)
+    fig.canvas.draw()
+    assert ax.xaxis.get_offset_text().get_text() == "" and ax.yaxis.get_offset_text().get_text() == ""
+    assert ax.get_xlim()[0] < 100  # seconds since the first sample, not 1.7e9
+    code, _, err = invoke("segments", epoch, "--units", "deg/s", "--angle", "90", "--plot", tmp_path / "s.png")
+    assert code == 0 and (tmp_path / "s.png").stat().st_size > 10_000, err
+
+
+# ---------------------------------------------------------------- simulate
+
+
+def test_simulate_rates_with_their_units_and_counts_with_a_sensitivity(tmp_path):
+    """Reference: the truth sidecar, which stores SI; 2 deg/s of noise is 0.0349 rad/s."""
+    from gyrocal.files import load
+    from gyrocal.io import read_recording
+    from gyrocal.simulation.truth import SimulationTruth
+
+    code, _, err = invoke("simulate", "-o", tmp_path / "a.csv", "--noise", "2deg/s", "--b", "0.5,0.1,0.2deg/s",
+                          "--speed", "1.0471975511965976rad/s")
+    assert code == 0, err
+    truth = load(tmp_path / "a.truth.json", SimulationTruth)
+    np.testing.assert_allclose(truth.settings["noise_std"], math.radians(2.0), rtol=1e-12)
+    np.testing.assert_allclose(truth.model.b, np.radians([0.5, 0.1, 0.2]), rtol=1e-12)
+    assert truth.settings["speed_deg_s"] == pytest.approx(60.0)
+    assert "--noise must be a number" in refused("simulate", "-o", tmp_path / "b.csv", "--noise", "loud")
+    line = refused("simulate", "-o", tmp_path / "c.csv", "--units", "counts")
+    assert "--units counts needs the sensitivity" in line and "--sensitivity" in line
+    code, _, err = invoke("simulate", "-o", tmp_path / "c.csv", "--units", "counts", "--sensitivity", "131")
+    assert code == 0, err
+    raw = read_recording(tmp_path / "c.csv", units="counts")
+    deg = read_recording(tmp_path / "c.csv", units="counts", sensitivity=131)
+    assert raw.units == "counts" and np.array_equal(raw.gyro, np.round(raw.gyro))
+    assert (tmp_path / "c.csv").read_text().startswith("# gyrocal simulate --protocol servo; gyro in counts (131 LSB")
+    assert np.abs(np.degrees(deg.gyro)).max() > 55  # the 60 deg/s turns, through the sensitivity
+
+
+def test_a_large_session_says_its_size_first(tmp_path):
+    code, out, err = invoke("simulate", "-o", tmp_path / "s.csv", "--protocol", "static", "--duration", "5100")
+    assert code == 0, err
+    first = out.splitlines()[0]
+    assert first.startswith("simulating 1.02 M samples (1.42 h of data at 200 Hz): about ") and "MB of CSV" in first
+    estimate = float(first.split("about ")[1].split(" MB")[0])
+    actual = (tmp_path / "s.csv").stat().st_size / 1e6
+    assert 0.7 < estimate / actual < 1.4, (estimate, actual)
+
+
+def test_skip_rows_reaches_noise_and_thermal(tmp_path):
+    code, _, err = invoke("simulate", "-o", tmp_path / "still.csv", "--protocol", "static", "--duration", "60")
+    assert code == 0, err
+    lines = [line for line in (tmp_path / "still.csv").read_text().splitlines() if not line.startswith("#")]
+    pre = tmp_path / "pre.csv"
+    width = len(lines[0].split(","))  # a preamble as wide as the table: only the user knows where it ends
+    pre.write_text(",".join(["sensor"] + ["x"] * (width - 1)) + "\n" + ",".join(map(str, range(width))) + "\n"
+                   + "\n".join(lines) + "\n")
+    assert "--skip-rows N" in refused("noise", pre, "--units", "deg/s")
+    code, out, err = invoke("noise", pre, "--units", "deg/s", "--skip-rows", "2")
+    assert code == 0, err
+    for command in ("thermal", "thermal-report"):
+        code, out, _ = invoke(command, "--help")
+        assert code == 0 and "--skip-rows" in out

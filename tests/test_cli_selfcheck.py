@@ -92,3 +92,32 @@ def test_refusals_are_one_line(tmp_path, rng):
                                  "duration": 10.0, "units": {}}))
     line = refused("calibrate", path, "--units", "deg/s", "--angle", "360", "--noise-density", noise)
     assert "--noise-density" in line and "zero noise density on x, y, z" in line
+
+
+def test_simulate_writes_each_defect_with_its_truth(tmp_path):
+    """``simulate`` with receive-time stamps, gaps, ripple and per-turn angles: the truth sidecar says what was
+    done, and its windows are rows of the written recording (checked against the recording itself)."""
+    out = tmp_path / "defects.csv"
+    code, _, err = invoke("simulate", "-o", out, "--stamps", "receive", "--late-per-minute", "6", "--gaps", "2",
+                          "--ripple", "0.05", "--vibration", "0", "--revolutions", "1,1,0.5,0.5,0.75,0.75",
+                          "--sample-rate", "100", "--seed", "3")
+    assert code == 0, err
+    truth = json.loads((tmp_path / "defects.truth.json").read_text())
+    assert truth["settings"]["stamps"] == "receive" and truth["settings"]["ripple"] == 0.05
+    assert truth["settings"]["revolutions"] == [1, 1, 0.5, 0.5, 0.75, 0.75]
+    assert [c for _, c in truth["time_base"]["gaps"]] == [17, 17]
+    data = np.loadtxt(out, delimiter=",", skiprows=2)
+    t, gyro = data[:, 0], np.radians(data[:, 1:])
+    assert np.median(np.diff(t)) < 0.006  # bursty stamps
+    # each true turn, as rows of the recording, integrates to its angle (k = 1, b = 0): within 4 sigma of the
+    # white noise (0.035 rad/s over ~700 samples of 10 ms: 0.5 deg) unless a gap took up to 17 samples
+    # (at most 17 x 10 ms x 60 deg/s x 1.05 = 11 deg) out of it
+    from gyrocal.simulation.timestamps import rows_after_gaps
+
+    rows = [int(rows_after_gaps(start, truth["time_base"]["gaps"])) for start, _ in truth["time_base"]["gaps"]]
+    for w in (w for w in truth["windows"] if w["kind"] == "rotation"):
+        angle = math.degrees(np.linalg.norm(np.sum(gyro[w["start"]:w["stop"]], axis=0)) / 100)  # 10 ms a sample
+        gap = any(w["start"] < r < w["stop"] for r in rows)
+        assert -11 - 2 < angle - w["angle_deg"] < 2 if gap else abs(angle - w["angle_deg"]) < 2
+    line = refused("simulate", "-o", tmp_path / "x.csv", "--late-per-minute", "3")
+    assert "--late-per-minute is for --stamps receive" in line

@@ -108,7 +108,7 @@ def _verify_args(folder, *extra):
 @pytest.mark.parametrize("extra, words", [
     ((), "--ref-units is required"),
     (("--ref-units", "counts"), "--ref-sensitivity"),
-    (("--ref-units", "deg/s", "--units", "rad/s"), "does not match the calibration's input units"),
+    (("--ref-units", "deg/s", "--units", "counts"), "applies to rates in deg/s, not to raw counts; give --units"),
     (("--ref-units", "deg/s", "--stretch", "5"), "--stretch must be two times"),
     (("--ref-units", "deg/s", "--ref-columns", "gx=nope"), "nope"),
 ])
@@ -180,3 +180,29 @@ def test_installed_entry_point_exits_1_outside_the_tolerance(tmp_path):
                           check=False)
     assert proc.returncode == 1, proc.stderr
     assert "OUTSIDE 3 sigma" in proc.stdout and "bx" in proc.stdout
+
+
+def test_bundled_example_verifies_against_its_truth(tmp_path):
+    """The bundled testing period and reference log: the clock and mounting in the sidecar come back."""
+    from importlib import resources
+
+    truth = json.loads((resources.files("gyrocal") / "data" / "example_servo_repeat.truth.json").read_text())
+    save(Calibration(model=ScaleBias(truth["k"], truth["b"]), input_units="deg/s", output_units="deg/s"),
+         tmp_path / "cal.json")
+    code, out, err = invoke("verify", tmp_path / "cal.json", "--example", "-o", tmp_path / "out", "--no-figures",
+                            "--replicates", "100")
+    assert code == 0, err
+    assert "same as: gyrocal verify" in out
+    a = load(tmp_path / "out" / "verify.json").alignment
+    ref = truth["reference"]
+    assert abs(a.time_offset_s - ref["time_offset_s"]) < 4 * a.std[0]
+    assert abs(a.clock_drift_ppm - ref["clock_drift_ppm"]) < 4 * a.std[1]
+    assert abs(a.rotation_deg - ref["mounting_rotation_deg"]) < 4 * a.rotation_deg_std
+    assert "not both" in refused("verify", tmp_path / "cal.json", "x.csv", "--example", "-o", tmp_path / "o2")
+
+
+def test_reference_reading_errors_name_the_ref_flags(bench, tmp_path):
+    """A reference in deg/s declared as rad/s: the reader's hint names --ref-units and --ref-no-unit-check."""
+    folder, _ = bench
+    line = refused(*_verify_args(folder, "--ref-units", "rad/s"))
+    assert "use --ref-units deg/s (or --ref-no-unit-check)" in line

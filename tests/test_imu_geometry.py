@@ -88,3 +88,18 @@ def test_triangular_frame_is_a_rotation_of_the_correction():
     assert np.allclose(np.triu(lower, 1), 0) and np.all(np.diag(lower) > 0)
     np.testing.assert_allclose(rot @ rot.T, np.eye(3), atol=1e-12)
     np.testing.assert_allclose(lower, rot @ a, atol=1e-12)
+
+
+def test_poses_picture_draws_every_pose_and_move():
+    """The sphere picture's artists: one point and label per pose, one arc per move, red for disagreeing pairs."""
+    from gyrocal.plotting import new_figure
+    from gyrocal.plotting.imu import draw_poses
+
+    dirs = fibonacci_directions(7)
+    ax = new_figure().add_subplot(projection="3d")
+    art = draw_poses(ax, dirs, disagree=[2], empty_cap=(np.array([0.0, 0.0, 1.0]), 30.0))
+    assert art["points"].get_offsets().shape[0] == 7 and len(art["labels"]) == 7
+    assert len(art["moves"]) == 6
+    colors = [m.get_color() for m in art["moves"]]
+    assert colors[2] == "tab:red" and colors.count("tab:red") == 1
+    assert len(art["empty_cap"]) == 1

@@ -64,17 +64,30 @@ def test_more_poses_and_larger_tilts_help_and_a_half_turn_sequence_is_degenerate
 
 def test_suggestion_is_the_shortest_plan_that_reaches_the_targets():
     targets = {"gyro_scale": 2e-4, "accel_offset": 2e-3}
-    plan = suggest_poses(targets, accel_noise_density=4e-3, gyro_noise_density=9e-5)
+    grid = dict(pose_counts=(12, 24, 36), turns=(45.0, 90.0))
+    plan = suggest_poses(targets, accel_noise_density=4e-3, gyro_noise_density=9e-5, **grid)
     assert all(plan.figures()[k] <= v for k, v in targets.items())
     shorter = [predict_poses(n, t, accel_noise_density=4e-3, gyro_noise_density=9e-5)
-               for n in (9, 12, 18, 24, 36, 48) for t in (45.0, 90.0, 135.0, 180.0)]
+               for n in grid["pose_counts"] for t in grid["turns"]]
     assert all(p.total_time >= plan.total_time or any(p.figures()[k] > v for k, v in targets.items())
                for p in shorter)
 
 
 def test_unreachable_targets_are_refused_with_the_closest_plan():
-    with pytest.raises(DegenerateDesignError, match="no plan of up to 48 poses reaches the targets; the closest"):
-        suggest_poses({"gyro_scale": 1e-7})
+    with pytest.raises(DegenerateDesignError, match="no plan of up to 16 poses reaches the targets; the closest"):
+        suggest_poses({"gyro_scale": 1e-7}, pose_counts=(12, 16), turns=(90.0,))
     with pytest.raises(InputError, match="targets must name"):
         suggest_poses({"scale": 1e-3})
     assert fibonacci_directions(3).shape == (3, 3)
+
+
+def test_plan_command_for_poses():
+    """The CLI prints the library's prediction (same numbers) and refuses servo-only flags."""
+    from cli_runner import invoke, refused
+
+    code, out, err = invoke("plan", "--design", "poses", "--poses", "16", "--tilt", "90", "--noise-density",
+                            "1e-4", "--accel-noise-density", "0.002", "--sample-rate", "100")
+    assert code == 0, err
+    f = predict_poses(16, 90.0, sample_rate=100.0, accel_noise_density=0.002, gyro_noise_density=1e-4).figures()
+    assert f"{1e4 * f['gyro_scale']:.3g}" in out and f"{f['accel_offset']:.2g}" in out
+    assert "--speed does not apply to --design poses" in refused("plan", "--design", "poses", "--speed", "30")

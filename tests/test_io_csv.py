@@ -1,4 +1,7 @@
-"""Reading text recordings: layouts real logs come in, and every bad input."""
+"""Reading text recordings: layouts real logs come in, and every bad input.
+
+References: the numbers each test writes into its own small files.
+"""
 
 from __future__ import annotations
 

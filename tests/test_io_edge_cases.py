@@ -1,5 +1,9 @@
 """Inputs that used to slip through or give a confusing message: time units, unit mix-ups,
-missing or duplicated headers, UTF-16 text."""
+missing or duplicated headers, UTF-16 text.
+
+References: the numbers and layouts each test writes into its own small files, and the one-line messages
+users see.
+"""
 
 from __future__ import annotations
 

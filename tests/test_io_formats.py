@@ -1,4 +1,8 @@
-"""Parquet and ROS bags (ROS 1, ROS 2 SQLite, MCAP) read back into recordings; the CSV writer."""
+"""Parquet and ROS bags (ROS 1, ROS 2 SQLite, MCAP) read back into recordings; the CSV writer.
+
+References: the arrays written with pyarrow and rosbags' own writers, read back by gyrocal; Python's csv
+module for the writer.
+"""
 
 from __future__ import annotations
 

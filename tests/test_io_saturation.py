@@ -1,4 +1,8 @@
-"""Saturation: runs stuck at full scale, and what is not saturation."""
+"""Saturation: runs stuck at full scale, and what is not saturation.
+
+References: a virtual gyro clipped at a known full scale (the clipped samples are known exactly) and
+noisy signals that are not clipped.
+"""
 
 from __future__ import annotations
 

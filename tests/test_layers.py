@@ -22,7 +22,7 @@ _FRONT = {"io", "cli", "plotting", "simulation", "studies", "export", "exporters
 FORBIDDEN: dict[str, set[str]] = {
     **{core: _FRONT | {"files", "firmware"}
        for core in ("models", "observations", "estimators", "design", "segmentation", "windows", "recording",
-                    "units", "saturation", "planning", "noise", "stillness", "flight")},
+                    "units", "saturation", "planning", "noise", "stillness", "flight", "imu")},
     # ThermalCalibration is a calibration kind: it registers with gyrocal.files and has c_header (firmware)
     "thermal": _FRONT,
     "simulation": {"io", "cli", "plotting", "studies", "thermal", "firmware", "export", "exporters"},

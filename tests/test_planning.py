@@ -1,4 +1,8 @@
-"""Protocol planning: predictions, and the suggested protocol reaches its target."""
+"""Protocol planning: predictions, and the suggested protocol reaches its target.
+
+References: the design's Cramer-Rao bound, the 1/sqrt(revolutions) law, and a brute-force search over
+the same grid.
+"""
 
 import math
 

@@ -1,4 +1,7 @@
-"""The calibration picture, checked through its artists (no pyplot state)."""
+"""The calibration picture, checked through its artists (no pyplot state).
+
+References: the figure's own artists (lines, spans and labels) against the recording and windows drawn.
+"""
 
 import math
 
@@ -70,7 +73,7 @@ def test_figure_has_raw_over_corrected_and_saves(rng, tmp_path):
     fig = calibration_figure(rec, windows, Calibration(model=TRUE, input_units="deg/s"), title="t")
     axes = fig.get_axes()
     assert len(axes) == 2 and axes[0].get_position().y0 > axes[1].get_position().y0
-    assert axes[1].get_xlabel() == "time [s]"
+    assert axes[1].get_xlabel() == "time since the first sample [s]"
     assert calibration_figure(rec, windows, fig=new_figure()).get_axes()[0].get_ylabel() == "raw [deg/s]"
     out = tmp_path / "cal.png"
     save_figure(fig, out)

@@ -135,7 +135,7 @@ def test_wrong_declared_angle_is_ignored(rng):
 def test_missing_axis_is_reported_with_what_was_found(rng):
     rec, _ = _session(ServoProtocol(turns=("+x", "-x", "+y", "-y")), rng)
     with pytest.raises(SegmentationError, match=r"found rotations \+x, -x, \+y, -y; 5 static window\(s\): "
-                                                 r"no rotation about z\."):
+                                                 r"no rotation about z; .*most likely: turn about the missing axes"):
         segment(rec, reference="speed", speed=SPEED)
 
 

@@ -1,4 +1,7 @@
-"""The servo and hand-turn simulator: exact turn angles, plateaus, vibration, mounting."""
+"""The servo and hand-turn simulator: exact turn angles, plateaus, vibration, mounting.
+
+References: the commanded protocol (angles, waits, speeds, tilt) and the gyro model's noise statistics.
+"""
 
 import math
 

@@ -1,4 +1,7 @@
-"""``gyrocal thermal`` and ``gyrocal thermal-report``, in process and once through the installed entry point."""
+"""``gyrocal thermal`` and ``gyrocal thermal-report``, in process and once through the installed entry point.
+
+References: the simulated thermal truth and the files the commands write.
+"""
 
 import json
 import subprocess

@@ -1,4 +1,8 @@
-"""3-node Lagrange interpolation (the full-temperature-range method, eq. 21-22) and its stencil and range rules."""
+"""3-node Lagrange interpolation (the full-temperature-range method, eq. 21-22) and its stencil and range rules.
+
+References: quadratics reproduced exactly, node values hit exactly, and the stencil rule of
+docs/thermal.md written out node by node.
+"""
 
 import warnings
 

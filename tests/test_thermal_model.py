@@ -172,3 +172,15 @@ def test_temperature_smoothing_equals_two_passes_of_scipy_lfilter(rng, fs, tau, 
     y, _ = lfilter([1 - a], [1, -a], x, zi=[a * x[0]])
     y, _ = lfilter([1 - a], [1, -a], y[::-1], zi=[a * y[-1]])
     np.testing.assert_allclose(smooth_temperature(x, fs, tau), y[::-1], rtol=1e-11, atol=0)
+
+
+def test_compensation_equals_numpy_solve_per_sample(rng):
+    """Reference: numpy.linalg.solve of K(T) w = raw - B(T) sample by sample, with K(T), B(T) from kg_at;
+    enough samples to span several of the compensation's chunks."""
+    cal = _cal()
+    n = 150_000
+    temp = rng.uniform(-40.0, 50.0, n)
+    raw = rng.normal(0.0, 2.0, (n, 3))
+    K, B = kg_to_kb(cal.kg_at(temp))
+    want = np.linalg.solve(K, (raw - B)[..., None])[..., 0]
+    np.testing.assert_allclose(cal.compensate(raw, temp), want, rtol=1e-12, atol=1e-14)

@@ -1,4 +1,7 @@
-"""Steps and temperature points from turntable recordings, and the session's bad-input errors."""
+"""Steps and temperature points from turntable recordings, and the session's bad-input errors.
+
+References: the turntable protocol's own steps and temperatures, and the simulated thermal truth.
+"""
 
 import numpy as np
 import pytest

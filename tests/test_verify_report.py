@@ -104,10 +104,15 @@ def test_error_panel_and_stretch(verified):
     fig = Figure()
     ax = fig.add_subplot()
     stretch = (series.t[100], series.t[600])
-    before, after = plot_errors(ax, series.t, series.raw - series.reference, series.calibrated - series.reference, 0,
-                                units="deg/s", stretch=stretch)
+    err_after = series.calibrated - series.reference
+    before, after, before_mean, after_mean = plot_errors(ax, series.t, series.raw - series.reference, err_after, 0,
+                                                         units="deg/s", stretch=stretch, smooth_s=0.5)
     assert before.get_xdata()[0] == series.t[100] and after.get_xdata()[-1] == series.t[600]
-    assert np.allclose(after.get_ydata(), (series.calibrated - series.reference)[100:601, 0])
+    assert np.allclose(after.get_ydata(), err_after[100:601, 0])
+    # the bold line is the centred 0.5 s mean (100 samples at 200 Hz) of the error, checked at one sample
+    i = 300
+    assert after_mean.get_ydata()[i - 100] == pytest.approx(err_after[i - 50:i + 50, 0].mean())
+    assert after_mean.get_linewidth() > after.get_linewidth()
 
 
 def test_whole_figures_have_three_panels(verified):

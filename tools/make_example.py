@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Regenerate the bundled example recording ``src/gyrocal/data/example_servo.csv``.
+"""Regenerate the bundled example recordings in ``src/gyrocal/data/``.
 
 The gyro is the MPU9250 of the servo method of Wang et al., Table III (k = 1.0069, 0.9960, 0.9955;
 b = 0.0442, -0.0089, 0.0076 rad/s) with the paper's simulated white noise
@@ -8,13 +8,23 @@ b = 0.0442, -0.0089, 0.0076 rad/s) with the paper's simulated white noise
 360 deg clockwise and counter-clockwise about x, y and z at 60 deg/s, 3 s apart,
 with 0.3 s speed ramps, 5 % servo vibration and a 5 deg mounting misalignment.
 
+A second pair is the paper's testing period (its Figs. 9-10, Tables IV-V): the same gyro
+repeats the same movements (``example_servo_repeat.csv``) while a reference gyro on the same
+board records them (``example_servo_reference.csv``): an ADIS16465-class sensor (white noise
+0.0025 deg/s/sqrt(Hz)) read at 100 Hz by its own logger, whose clock runs 35 ppm slow of the
+test gyro's and was started 1.83 s after it, mounted 3 deg off the test gyro's axes.
+``gyrocal verify cal.json --example -o verify/`` checks a calibration on this pair.
+
 Usage::
 
-    python tools/make_example.py            # writes the CSV and its truth sidecar
+    python tools/make_example.py            # writes the CSVs and their truth sidecars
     python tools/make_example.py --check    # regenerates in memory and compares
 
-The sidecar ``example_servo.truth.json`` (format ``gyrocal.simulation-truth``, the same as
-``gyrocal simulate`` writes) holds the true parameters, the mounting rotation and the true windows. The run is seeded, so the output is reproducible.
+The sidecars ``example_servo.truth.json`` and ``example_servo_repeat.truth.json`` (format
+``gyrocal.simulation-truth``, the same as ``gyrocal simulate`` writes) hold the true
+parameters, the mounting rotation and the true windows; the second also the reference's
+clock offset and drift, mounting rotation and noise. The runs are seeded, so the output is
+reproducible.
 """
 
 from __future__ import annotations
@@ -29,10 +39,16 @@ import numpy as np
 
 from gyrocal import ScaleBias
 from gyrocal.simulation import VirtualGyro
+from gyrocal.simulation.reference import ADIS16465_NOISE_DENSITY, simulate_reference
 from gyrocal.simulation.servo import ServoProtocol, simulate_servo
 from gyrocal.simulation.truth import SimulationTruth, servo_facts
 
 SEED = 20260522
+REPEAT_SEED = 20260523  # the testing period: the same movements, recorded again
+REF_RATE = 100.0  # Hz, the reference's logger
+REF_OFFSET_S = -1.83  # t_test = t_ref * (1 + drift) + offset: the reference logger started 1.83 s later
+REF_DRIFT_PPM = 35.0
+REF_MOUNTING_DEG = 3.0
 SAMPLE_RATE = 200.0  # Hz
 K = (1.0069, 0.9960, 0.9955)  # the servo method of Wang et al., Table III, MPU9250
 B = (0.0442, -0.0089, 0.0076)  # rad/s, same table
@@ -61,16 +77,19 @@ def csv_text(rec) -> str:
     return "t,gx,gy,gz\n" + rows + "\n"
 
 
-def truth_doc(truth, protocol: ServoProtocol) -> dict:
+def truth_doc(truth, protocol: ServoProtocol, seed: int = SEED, reference: dict | None = None) -> dict:
     """The truth sidecar, in the one format of simulated truth (gyrocal.simulation.truth)."""
     settings = {
-        "seed": SEED, "sample_rate": SAMPLE_RATE, "units": "deg/s", "noise_std": NOISE_STD,
+        "seed": seed, "sample_rate": SAMPLE_RATE, "units": "deg/s", "noise_std": NOISE_STD,
         "quantum_deg_s": 1.0 / LSB_PER_DPS, "full_scale_deg_s": FULL_SCALE_DPS, "speed_deg_s": 60.0,
         "turns": list(protocol.turns), "wait_s": protocol.wait, "ramp_s": protocol.ramp,
         "vibration": protocol.vibration, "misalignment_deg": protocol.misalignment_deg,
     }
+    facts = servo_facts(truth)
+    if reference is not None:
+        facts["reference"] = reference
     doc = SimulationTruth(
-        protocol="servo", model=truth.model, settings=settings, facts=servo_facts(truth),
+        protocol="servo", model=truth.model, settings=settings, facts=facts,
         description="Simulated MPU9250 (the servo method of Wang et al., Table III) on its servo protocol; "
                     "regenerate with tools/make_example.py",
     ).to_document()
@@ -78,23 +97,53 @@ def truth_doc(truth, protocol: ServoProtocol) -> dict:
     return doc
 
 
-def generate() -> tuple[str, str]:
+def reference_csv_text(rec) -> str:
+    """The reference log as CSV text in deg/s (times on its own clock, 6 decimals below its noise)."""
+    g = np.degrees(rec.gyro)
+    rows = "\n".join(f"{t:.3f},{x:.6f},{y:.6f},{z:.6f}" for t, (x, y, z) in zip(rec.t, g))
+    return "t,gx,gy,gz\n" + rows + "\n"
+
+
+def testing_period():
+    """The paper's testing period: the repeated session, its truth, the reference log and its truth."""
+    gyro, protocol, fs = example_setup()
+    rng = np.random.default_rng(REPEAT_SEED)
+    repeat, repeat_truth = simulate_servo(gyro, protocol, sample_rate=fs, rng=rng)
+    ref_gyro = VirtualGyro(model=ScaleBias(k=(1.0, 1.0, 1.0), b=(0.0, 0.0, 0.0)),
+                           noise_std=ADIS16465_NOISE_DENSITY * math.sqrt(REF_RATE))
+    ref, ref_truth = simulate_reference(repeat.t, repeat_truth.rates, ref_gyro, sample_rate=REF_RATE,
+                                        time_offset_s=REF_OFFSET_S, clock_drift_ppm=REF_DRIFT_PPM,
+                                        mounting_deg=REF_MOUNTING_DEG, rng=rng)
+    return repeat, repeat_truth, ref, ref_truth
+
+
+def generate() -> dict[str, str]:
+    """File name -> content of every bundled example file."""
     gyro, protocol, fs = example_setup()
     rec, truth = simulate_servo(gyro, protocol, sample_rate=fs, rng=np.random.default_rng(SEED))
-    return csv_text(rec), json.dumps(truth_doc(truth, protocol), indent=2) + "\n"
+    repeat, repeat_truth, ref, ref_truth = testing_period()
+    reference = {"path": "example_servo_reference.csv", "units": "deg/s", **ref_truth.to_dict()}
+    return {
+        "example_servo.csv": csv_text(rec),
+        "example_servo.truth.json": json.dumps(truth_doc(truth, protocol), indent=2) + "\n",
+        "example_servo_repeat.csv": csv_text(repeat),
+        "example_servo_repeat.truth.json": json.dumps(
+            truth_doc(repeat_truth, protocol, REPEAT_SEED, reference), indent=2) + "\n",
+        "example_servo_reference.csv": reference_csv_text(ref),
+    }
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--check", action="store_true", help="compare with the bundled files instead of writing")
     args = parser.parse_args(argv)
-    csv, truth = generate()
-    paths = (DATA / "example_servo.csv", DATA / "example_servo.truth.json")
+    files = generate()
     if args.check:
-        same = all(p.read_text() == text for p, text in zip(paths, (csv, truth)))
+        same = all((DATA / name).is_file() and (DATA / name).read_text() == text for name, text in files.items())
         print("bundled example is up to date" if same else "bundled example differs; rerun without --check")
         return 0 if same else 1
-    for path, text in zip(paths, (csv, truth)):
+    for name, text in files.items():
+        path = DATA / name
         path.write_text(text)
         print(f"wrote {path} ({path.stat().st_size / 1e6:.2f} MB)")
     return 0

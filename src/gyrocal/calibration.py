@@ -185,6 +185,9 @@ class Calibration:
                                   "source_units": self.output_units, "sensitivity": None}
         if self.accelerometer is not None and rec.accel is not None:
             fields.update(self.accelerometer.apply_to(rec))
+            coupling = self.accelerometer.gyro_coupling(fields.get("accel"))
+            if coupling is not None:  # the gyro's g-sensitivity, in input units
+                fields["gyro"] = self.model.correct(raw - coupling * self.input_scale)
         return replace(rec, **fields)
 
     def c_header(self, prefix: str = "gyrocal") -> str:

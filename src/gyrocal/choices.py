@@ -10,20 +10,25 @@ from __future__ import annotations
 from typing import Literal, get_args
 
 __all__ = [
+    "AccelModel",
+    "AccelOutputUnit",
     "AccelUnit",
     "CaptureWire",
     "DesignName",
     "DeviceWire",
     "GuideName",
+    "ImuGyroModel",
     "InputUnit",
     "Method",
     "MotionPolicy",
     "OutOfRange",
+    "PlanDesign",
     "Protocol",
     "RateUnit",
     "SaturationPolicy",
     "StudyName",
     "TableModel",
+    "TimeStamps",
     "values",
 ]
 
@@ -42,9 +47,11 @@ OutOfRange = Literal["refuse", "clamp", "extrapolate"]
 #: How a thermal table is evaluated in temperature ("traditional": the paper's one-temperature baseline).
 TableModel = Literal["lagrange", "smooth", "traditional"]
 #: Motion sources of ``gyrocal simulate`` (see :mod:`gyrocal.simulation`).
-Protocol = Literal["servo", "hand", "turntable", "profile", "static"]
+Protocol = Literal["servo", "hand", "turntable", "profile", "static", "multi-position"]
 #: What a noise analysis does with a log that moves: analyse its longest still stretch, or refuse it.
 MotionPolicy = Literal["restrict", "refuse"]
+#: How ``gyrocal simulate`` stamps its samples: on the sensor's clock, or as a PC receiving packets.
+TimeStamps = Literal["sensor", "receive"]
 #: Monte Carlo studies reproducing the papers (see :mod:`gyrocal.studies`).
 StudyName = Literal["servo-normal", "servo-extreme", "servo-speed", "servo-convergence", "thermal-compare"]
 #: Wire formats ``gyrocal capture`` reads ("auto": whichever decodes first; see :mod:`gyrocal.capture`).
@@ -55,6 +62,16 @@ DeviceWire = Literal["frames", "text"]
 GuideName = Literal["servo", "hand"]
 #: Experimental designs of the planner (see :mod:`gyrocal.planning`).
 DesignName = Literal["six", "six-static", "twelve"]
+#: Designs ``gyrocal plan`` predicts: the servo designs, and a hand session of still poses (see
+#: :mod:`gyrocal.imu.planning`).
+PlanDesign = Literal["six", "six-static", "twelve", "poses"]
+#: Accelerometer models of the whole-IMU calibration ("auto": the largest the poses determine;
+#: see :mod:`gyrocal.imu.accel`).
+AccelModel = Literal["auto", "affine", "triangular", "scale-bias"]
+#: Gyro models of the whole-IMU calibration (see :mod:`gyrocal.imu.gyro`).
+ImuGyroModel = Literal["auto", "affine", "scale"]
+#: Units of corrected accelerations.
+AccelOutputUnit = Literal["m/s^2", "g"]
 
 
 def values(choice) -> tuple[str, ...]:

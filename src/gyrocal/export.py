@@ -24,6 +24,7 @@ EXPORTER_MODULES: dict[str, str] = {
     "json": "gyrocal.exporters",
     "yaml": "gyrocal.exporters",
     "c-header": "gyrocal.exporters",
+    "imucal": "gyrocal.imucal_export",
     "kalibr": "gyrocal.flight_exporters",
     "vins": "gyrocal.flight_exporters",
     "imu_utils": "gyrocal.flight_exporters",

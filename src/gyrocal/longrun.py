@@ -88,47 +88,54 @@ def find_lines(y: np.ndarray, *, max_lines: int = 3, threshold: float = 25.0, mi
 
 
 def _design(t: np.ndarray, lines: list[float]) -> np.ndarray:
-    cols = [np.ones_like(t)]
-    for f in lines:
-        cols += [np.cos(2 * np.pi * f * t), np.sin(2 * np.pi * f * t)]
-    return np.stack(cols, axis=1)
+    """Regressors (n, 1 + 2 L): a constant, then the cosine and sine of each line at times `t`."""
+    X = np.empty((len(t), 1 + 2 * len(lines)))
+    X[:, 0] = 1.0
+    if lines:
+        phase = np.exp(2j * np.pi * np.multiply.outer(t, lines))  # (n, L)
+        X[:, 1::2], X[:, 2::2] = phase.real, phase.imag
+    return X
 
 
-def plateau_mean(x: np.ndarray, t: np.ndarray | None = None, *,
-                 lines: list[float] | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Level and its variance [units, units^2] of a steady stretch `x` (n, 3) with a periodic ripple.
+def fit_level(x: np.ndarray, t: np.ndarray, lines: list[float]) -> tuple[np.ndarray, float, np.ndarray]:
+    """Level of `x` (n, 3) at times `t` [in mean sample steps] with sinusoids at `lines` regressed out.
+
+    Returns the level (3,), the factor that turns a per-sample long-run variance into the level's
+    variance (``[(X^T X)^-1]_00``, 1/n without lines), and the residuals (n, 3).
+    """
+    if not lines:
+        level = x.mean(axis=0)
+        return level, 1.0 / len(x), x - level
+    X = _design(t, lines)
+    inv = np.linalg.inv(X.T @ X)
+    coef = inv @ (X.T @ x)
+    return coef[0], float(inv[0, 0]), x - X @ coef
+
+
+def block_means(x: np.ndarray, d: int) -> np.ndarray:
+    """Means of consecutive blocks of `d` rows of `x` (n,) or (n, k); the tail that fills no block is dropped."""
+    if d <= 1:
+        return x
+    m = len(x) // d
+    avg = np.full(d, 1.0 / d)
+    if x.ndim == 1:
+        return x[: m * d].reshape(m, d) @ avg
+    # column by column, as matrix-vector products: contiguous for column-major windows
+    return np.stack([c[: m * d].reshape(m, d) @ avg for c in x.T], axis=1)
+
+
+def plateau_mean(x: np.ndarray, *, lines: list[float] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Level and its variance [units, units^2] of one steady stretch `x` (n, 3) with a periodic ripple.
 
     A servo's or robot joint's speed ripple is a sinusoid on top of the level. It is found on the
     axis that turns (the largest mean) and regressed out together with the level; the level's
     variance is then that of a regression coefficient under the residuals' long-run variance
-    (Newey-West), so correlated noise counts too.
-
-    Parameters
-    ----------
-    x : ndarray, shape (n, 3)
-        Readings.
-    t : ndarray, shape (n,), optional
-        Sample times [s]; the regression then weighs each sample by the time it stands for
-        (trapezoid) and places the sinusoids on the stamps. Default: evenly spaced.
-    lines : list of float, optional
-        Ripple frequencies [cycles per mean sample step]; found with :func:`find_lines` by default.
+    (Newey-West), so correlated noise counts too. (The pipeline does the same for all plateaus at
+    once, with one set of ripple lines and one long-run variance pooled over them:
+    :func:`gyrocal.window_stats.observe_windows`.)
     """
     x = np.asarray(x, dtype=float)
-    n = len(x)
     if lines is None:
-        a = int(np.argmax(np.abs(x.mean(axis=0))))
-        lines = find_lines(x[:, a])
-    if t is None or n < 3:
-        tt, w = np.arange(n, dtype=float), np.ones(n)
-    else:
-        step = np.diff(t)
-        tt = (t - t[0]) / step.mean()
-        w = np.concatenate(([step[0]], (step[:-1] + step[1:]) / 2, [step[-1]])) / step.mean()
-    X = _design(tt, lines)
-    sw = np.sqrt(w)[:, None]
-    coef, *_ = np.linalg.lstsq(X * sw, x * sw, rcond=None)
-    resid = x - X @ coef
-    XtX_inv = np.linalg.inv((X * w[:, None]).T @ X)
-    lrv = newey_west_var(resid) * n  # long-run variance per sample
-    # var of the weighted coefficient: (X'WX)^-1 X'W S W X (X'WX)^-1 with S = lrv I, ~ lrv (X'WX)^-1 for w ~ 1
-    return coef[0], lrv * XtX_inv[0, 0]
+        lines = find_lines(x[:, int(np.argmax(np.abs(x.mean(axis=0))))])
+    level, factor, resid = fit_level(x, np.arange(len(x), dtype=float), lines)
+    return level, newey_west_var(resid) * len(x) * factor

@@ -120,6 +120,8 @@ def observe(
     speed: float | None = None,
     angle: float | None = None,
     t=None,
+    level=None,
+    mean_var=None,
 ) -> Observation:
     """Reduce a window of readings to an :class:`Observation`.
 
@@ -140,6 +142,11 @@ def observe(
         by the time each sample stands for, and the duration is the time spanned, so an
         angle reference still gives ``angle = mean rate x duration``. Without it the
         samples are taken as evenly spaced at `sample_rate`.
+    level : array_like, shape (3,), optional
+        The window's level when it is not its plain mean [reading units]: a plateau with its
+        speed ripple regressed out (:func:`gyrocal.longrun.fit_level`).
+    mean_var : array_like, shape (3,), optional
+        Variance of that level, measured on the data [reading units^2] (see :class:`Observation`).
     """
     m = finite_array("samples", samples, shape_tail=(3,), ndim=2)
     fs = positive("sample_rate", sample_rate)
@@ -163,7 +170,8 @@ def observe(
         raise InputError(f"kind={kind!r} is not one of {_KINDS}")
     d = np.diff(m, axis=0)
     return Observation(
-        mean=np.average(m, axis=0, weights=weights),
+        mean=np.average(m, axis=0, weights=weights) if level is None else level,
+        mean_var=mean_var,
         mean_sq=np.average(m * m, axis=0, weights=weights),
         noise_var=(d * d).mean(axis=0) / 2.0,
         count=len(m),

@@ -34,7 +34,7 @@ from .screening import require_constant_rate, screen_gaps
 from .segmentation import Segmentation, segment, standstill_level
 from .timebase import TimeBase
 from .units import parse_input_unit, parse_rate_unit, unit_factor
-from .window_stats import observe_window, pool_static_variance
+from .window_stats import observe_windows
 from .windows import Window
 
 __all__ = ["CalibrationRun", "calibrate", "parameter_rows"]
@@ -118,6 +118,9 @@ class CalibrationRun:
             lines.append(f"  noise std per sample [{cal.input_units}]: " + "  ".join(f"{v:.3g}" for v in noise))
         if (note := self.scale_bias_note()) is not None:
             lines.append("  note: " + note)
+        if self.quality is not None:
+            lines.append(self.quality.summary())
+        lines += [f"note: {n}" for n in self.notes] + [f"warning: {w}" for w in self.warnings]
         return "\n".join(lines)
 
 
@@ -209,6 +212,7 @@ def calibrate(
     noise_std=None,
     output_units: str | None = None,
     checks: bool = True,
+    long_run: bool = True,
 ) -> CalibrationRun:
     """Calibrate a gyro from one recording of a servo, gimbal, robot or hand session.
 
@@ -233,12 +237,16 @@ def calibrate(
         Unit of corrected rates; default the recording's unit, or deg/s for counts. For
         counts with a sensitivity it must be the unit the sensitivity refers to.
     checks : bool
-        Run the self-checks (default): the sensor clock rebuilt under the time stamps and turns
-        across real gaps bounded or left out, plateau levels with their speed ripple regressed
-        out and each window mean's own long-run variance, the paper's methods refusing varying
-        rates, goodness of fit with Birge scaling of the covariance, plausibility of k.
-        ``False`` gives the plain estimate on the stamps as they are (benchmarks and tests
-        compare the two).
+        Run the self-checks (default): the time base read from the stamps (the sensor clock
+        rebuilt under receive-time stamps; turns across real gaps bounded or left out), the
+        paper's methods refusing varying rates, goodness of fit with Birge scaling of the
+        covariance, plausibility of k, and the ``fit`` and ``observed`` sections of the file.
+    long_run : bool
+        First-moment only (default): each plateau's periodic speed ripple regressed out of its
+        level, and every plateau's and static window's mean variance from the long-run variance
+        of the data (correlated noise, what ripple is left), not sigma / sqrt(n).
+        ``checks=False, long_run=False`` is the plain estimate on the stamps as they are, with a
+        white-noise covariance (benchmarks and tests compare them).
 
     Raises
     ------
@@ -271,7 +279,8 @@ def calibrate(
                              value if reference == "angle" else None)
     tb = rec.time_base() if checks else None
     angle_var: dict = {}
-    times = None if tb is None else tb.clock_times()  # the sensor's clock under receive-time stamps
+    # the sensor's clock under receive-time stamps (stamps already on a regular clock are their own)
+    times = None if tb is None or (not tb.gaps and tb.jitter <= 1e-9 * tb.period) else tb.clock_times()
     if tb is not None:
         seg, angle_var = screen_gaps(seg, rec, tb, reference, times)
     uses_static = method == "first-moment"
@@ -279,9 +288,8 @@ def calibrate(
     used = seg.windows if uses_static else seg.rotations
     if checks and not uses_static:
         require_constant_rate(rec, used, seg.baseline, method)
-    observations = tuple(observe_window(rec, w, reference, value, long_run=checks and noise_std is None,
-                                        ripple=uses_static and checks, times=times) for w in used)
-    observations = pool_static_variance(observations)
+    observations = observe_windows(rec, used, reference, value, long_run=long_run and uses_static and noise_std is None,
+                                   ripple=long_run and uses_static, times=times)
     if angle_var:  # turns across a time-stamp gap: their rate is known within the gap's bound
         observations = tuple(dataclasses.replace(o, rate_var=angle_var[(w.start, w.stop)] * o.rate**2)
                              if (w.start, w.stop) in angle_var else o for w, o in zip(used, observations))
@@ -297,7 +305,7 @@ def calibrate(
                       declared=value if windows is None or reference == "speed" else math.nan,
                       sample_rate=rec.sample_rate, has_time=rec.has_time, sensitivity=rec.sensitivity)
         plausible, notes = check_plausibility(fit.model.k, ctx)
-        warnings = list(quality.warnings) + plausible
+        warnings = list(quality.warnings) + _single_turns(used, reference, value) + plausible
     cal = Calibration(
         model=fit.model,
         input_units=input_units,
@@ -307,10 +315,10 @@ def calibrate(
         covariance=fit.covariance,
         noise_std=fit.noise_std,
         windows=tuple({**w.to_dict(), "rate": o.rate} for w, o in zip(used, observations)),
-        fit=None if quality is None else quality.to_document(),
     )
-    if tb is not None:
-        cal = dataclasses.replace(cal, observed=_observed(rec, tb, fit.noise_std, cal.input_scale, input_units))
+    if checks:  # the file's sections, built once (freezing thousands of residuals costs)
+        cal = dataclasses.replace(cal, fit=quality.to_document(),
+                                  observed=_observed(rec, tb, fit.noise_std, cal.input_scale, input_units))
     return CalibrationRun(cal, fit, seg, observations, reference, value, quality, tb, tuple(warnings), tuple(notes))
 
 
@@ -319,12 +327,46 @@ def _observed(rec: Recording, tb: TimeBase, noise_std, input_scale: float, input
 
     `input_scale` is internal units per input unit (:attr:`gyrocal.calibration.Calibration.input_scale`).
     """
-    peak = np.maximum(rec.gyro.max(axis=0), -rec.gyro.min(axis=0))
+    # up to 20 000 evenly spread samples (every 50 ms at 1 kHz: a turn's rate lasts longer); the order of
+    # magnitude is what a unit check needs
+    sample = rec.gyro[:: max(1, len(rec) // 20_000)]
+    peak = np.array([max(float(c.max()), -float(c.min())) for c in sample.T])
     return {"sample_rate": rec.sample_rate, "units": input_units,
             "noise_std": (np.asarray(noise_std, dtype=float) / input_scale).tolist(),
             "max_abs_rate": (peak / input_scale).tolist(), "time_base": tb.to_document(),
             # the noise of the quiet stretches, measured as apply measures the data it corrects
-            "quiet_noise_std": quiet_noise(rec.gyro / input_scale, rec.sample_rate).tolist()}
+            "quiet_noise_std": (quiet_noise(_spread_blocks(rec.gyro, rec.sample_rate), rec.sample_rate)
+                                / input_scale).tolist()}
+
+
+def _spread_blocks(gyro: np.ndarray, sample_rate: float, most: int = 200) -> np.ndarray:
+    """Up to `most` whole blocks of :data:`gyrocal.observed.QUIET_BLOCK` seconds, evenly spread over `gyro`.
+
+    The quiet-noise level is a pooled standard deviation of quiet blocks: two hundred of them
+    give it to a fraction of a per cent, for a fraction of the work on a long log.
+    """
+    from .observed import QUIET_BLOCK
+
+    size = max(8, int(round(QUIET_BLOCK * sample_rate)))
+    blocks = len(gyro) // size
+    if blocks <= most:
+        return gyro
+    pick = np.linspace(0, blocks - 1, most).astype(np.intp)
+    return gyro[(pick[:, None] * size + np.arange(size)).ravel()]
+
+
+def _single_turns(windows: Sequence[Window], reference: str, declared: float) -> list[str]:
+    """A warning when some scale factor rests on one turn: its residual is zero, nothing checks it."""
+    turns = [w.axis for w in windows if w.kind == "rotation"]
+    alone = [a for a in "xyz" if turns.count(a) == 1]
+    if not alone:
+        return []
+    deg = math.degrees(declared)
+    what = (f"their declared angle (1 deg in {deg:g} is {1 / deg:.2g} in k)" if reference == "angle"
+            else "their declared speed")
+    return [f"the scale factor{'s' if len(alone) > 1 else ''} of {', '.join(alone)} rest{'' if len(alone) > 1 else 's'} "
+            f"on one turn each: nothing in the data checks {what}; turn both ways or repeat the turns so that the "
+            "fit can check itself"]
 
 
 def _label(w: Window) -> str:

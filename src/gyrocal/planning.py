@@ -62,6 +62,11 @@ class Plan:
     def max_bias_std(self) -> float:
         return float(self.std[3:].max())
 
+    def meets(self, target_scale: float | None = None, target_bias: float | None = None) -> bool:
+        """Whether every scale std is at most `target_scale` [-] and every bias std at most `target_bias` [rad/s]."""
+        return (target_scale is None or self.max_scale_std <= target_scale) and \
+            (target_bias is None or self.max_bias_std <= target_bias)
+
 
 def build_design(name: DesignName, speed: float, *, revolutions: float = 1.0, static_duration: float = 3.0,
                  pause: float = 3.0) -> Design:
@@ -129,6 +134,7 @@ def suggest(
     model: ScaleBias | None = None,
     speeds: Sequence[float] | None = None,
     revolutions: Sequence[float] = tuple(range(1, 21)),
+    baseline: Plan | None = None,
     **design_options,
 ) -> Plan | None:
     """The shortest protocol on a grid whose worst scale and bias std reach the targets.
@@ -147,27 +153,36 @@ def suggest(
         Speeds to try [rad/s]; default 20 steps from ``max_speed / 20`` to ``max_speed``.
     revolutions : sequence of float
         Revolutions per turn to try.
+    baseline : Plan, optional
+        The protocol the user has in mind. A suggestion is never worse than it on a target that
+        was set (its std stays at most the baseline's), and, when the baseline meets every
+        target, it is shorter than the baseline.
 
     Returns
     -------
     Plan or None
-        None when no grid point reaches the targets.
+        None when no grid point reaches the targets (or, with a `baseline` that meets them,
+        when none is shorter without giving up accuracy on a target).
     """
     if target_scale is None and target_bias is None:
-        raise InputError("give target_scale and/or target_bias: there is nothing to reach otherwise")
+        raise InputError("give target_scale and/or target_bias: there is nothing to reach otherwise",
+                         param="target_scale")
     for name, value in (("target_scale", target_scale), ("target_bias", target_bias)):
         if value is not None:
             positive(name, value)
     top = positive("max_speed", max_speed)
+    if baseline is not None:  # never worse than the user's protocol on what the user asked for
+        target_scale = None if target_scale is None else min(target_scale, baseline.max_scale_std)
+        target_bias = None if target_bias is None else min(target_bias, baseline.max_bias_std)
     grid = np.linspace(top / 20, top, 20) if speeds is None else np.asarray(speeds, dtype=float)
     best: Plan | None = None
     for rev in sorted(revolutions):
         for speed in grid:
             plan = predict(design, speed=float(speed), revolutions=rev, sample_rate=sample_rate,
                            noise_density=noise_density, model=model, **design_options)
-            ok = (target_scale is None or plan.max_scale_std <= target_scale) and \
-                 (target_bias is None or plan.max_bias_std <= target_bias)
-            if ok and (best is None or plan.total_time < best.total_time):
+            if plan.meets(target_scale, target_bias) and (best is None or plan.total_time < best.total_time):
                 best = plan
+    if best is not None and baseline is not None and baseline.meets(target_scale, target_bias) \
+            and best.total_time >= baseline.total_time:
+        return None  # the user's protocol is already the shortest that keeps its accuracy
     return best
-

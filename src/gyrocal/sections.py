@@ -174,10 +174,13 @@ class Section(Mapping):
 
 
 def _residuals(v):
-    """Residuals in noise units: numbers, or one ``{"window", "label", "z": [numbers]}`` object per window."""
-    if isinstance(v, tuple) and all(isinstance(r, Mapping) for r in v):
-        for r in v:
-            numbers((-1,))(r.get("z", ()))
+    """Residuals in noise units: numbers, one list of numbers per window (of any length), or one
+    ``{"window", "label", "z": [numbers]}`` object per window."""
+    if isinstance(v, tuple) and v and all(isinstance(z, (tuple, Mapping)) for z in v):
+        for r in v:  # plain Python: thousands of windows, a few numbers each
+            z = r.get("z", ()) if isinstance(r, Mapping) else r
+            if not isinstance(z, tuple) or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in z):
+                raise ValueError(f"must hold numbers in every window, got {_thaw(z)!r}")
         return v
     return numbers((-1,))(v)
 
@@ -188,15 +191,15 @@ class FitQuality(Section):
     Documented keys: ``chi2``, ``dof`` (0: no residual degrees of freedom, nothing checked),
     ``chi2_per_dof``, ``p_value`` (null without dof), ``birge_ratio`` (sqrt(chi2 / dof)),
     ``covariance_scaled`` (whether ``covariance`` and ``std`` were scaled by chi2 / dof, as when
-    p < 0.001), ``residuals`` (per window in noise units: ``{"window", "label", "z"}``, one ``z``
-    for a turn, three for a static window), ``disagree`` (the windows that disagree most, when
-    flagged), ``warnings`` (list of text).
+    p < 0.001), ``residuals`` (one list per window, in the order of ``windows``, in noise units:
+    one value for a turn, three for a static window), ``labels`` (the windows' names),
+    ``disagree`` (the windows that disagree most, when flagged), ``warnings`` (list of text).
     """
 
     NAME = "fit"
     FIELDS = {"chi2": number(0), "dof": integer(0), "chi2_per_dof": number(0), "p_value": number(0, 1),
               "birge_ratio": number(0), "covariance_scaled": boolean, "residuals": _residuals,
-              "disagree": numbers((-1,), 0), "warnings": texts}
+              "labels": texts, "disagree": numbers((-1,), 0), "warnings": texts}
 
 
 class Observed(Section):
@@ -218,12 +221,14 @@ class AccelerometerPart(Section):
 
     Documented keys: ``units`` ``{input, output, sensitivity, gravity}``, ``correction``
     ``{matrix (3, 3), offset (3,)}`` with ``a_true = matrix @ (raw - offset)`` in those units,
-    ``parameters``, ``std``, ``covariance``, ``fit``.
+    ``parameters``, ``std``, ``covariance``, ``fit``, ``gyro_g_sensitivity`` (null or ``{matrix (3, 3)}``
+    [gyro input units per m/s^2]: the gyro correction becomes ``matrix @ (raw - offset - G a_true)``).
+    The whole-IMU calibration (:mod:`gyrocal.imu.filedoc`) adds ``model``, ``sensor_axes``, ``poses``.
     """
 
     NAME = "accelerometer"
     FIELDS = {"units": obj, "correction": obj, "parameters": obj, "std": obj, "covariance": numbers((-1, -1)),
-              "fit": obj}
+              "fit": obj, "gyro_g_sensitivity": obj}
 
     @classmethod
     def _problem(cls, frozen: Mapping[str, Any]) -> tuple[str, str] | None:
@@ -235,6 +240,12 @@ class AccelerometerPart(Section):
                     numbers(shape)(corr.get(key))
                 except ValueError as exc:
                     return f"correction.{key}", str(exc)
+        coupling = frozen.get("gyro_g_sensitivity")
+        if problem is None and coupling is not None:
+            try:
+                numbers((3, 3))(coupling.get("matrix"))
+            except ValueError as exc:
+                return "gyro_g_sensitivity.matrix", str(exc)
         return problem
 
     def apply_to(self, rec) -> dict[str, Any]:
@@ -261,6 +272,17 @@ class AccelerometerPart(Section):
         matrix, offset = np.asarray(_thaw(corr["matrix"]), float), np.asarray(_thaw(corr["offset"]), float)
         return {"accel": ((raw - offset) @ matrix.T) * factor[u_out], "accel_units": "m/s^2",
                 "accel_source_units": u_out, "accel_sensitivity": None}
+
+    def gyro_coupling(self, accel_true) -> np.ndarray | None:
+        """The gyro's g-sensitivity term ``G a_true`` (N, 3) [gyro input units], or None without one.
+
+        `accel_true` is the corrected specific force [m/s^2] (``apply_to(rec)["accel"]``); the gyro
+        correction then reads ``w_true = matrix @ (raw - offset - G a_true)``.
+        """
+        g = self.get("gyro_g_sensitivity")
+        if g is None or accel_true is None:
+            return None
+        return np.asarray(accel_true, dtype=float) @ np.asarray(_thaw(g["matrix"]), dtype=float).T
 
 
 def section(cls: type[Section], value: Any) -> Section | None:

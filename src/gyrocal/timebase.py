@@ -28,7 +28,8 @@ from .errors import InputError
 __all__ = ["Gap", "TimeBase", "analyse_time", "nominal_period"]
 
 _BLOCK = 64  # steps per block of the robust period estimate
-_ENVELOPE = 50  # samples each side over which the clock residual's lower envelope is taken
+_ENVELOPE = 50  # samples each side over which the clock residual's lower envelope is taken, at least
+_ENVELOPE_S = 0.5  # [s] and at least this long: a late packet's burst must drain inside it
 #: Steps below this multiple of the period cannot hide a lost sample and are not examined.
 _CANDIDATE_STEP = 1.5
 #: A step this many periods long that lost nothing is a late delivery (shorter ones are jitter).
@@ -131,10 +132,13 @@ class TimeBase:
 
     def clock_numbers(self) -> np.ndarray:
         """Each sample's number on the sensor clock (N,): its index plus the samples lost before it."""
-        add = np.zeros(self.n)
-        for g in self.gaps:
-            add[g.index] += g.lost
-        return np.arange(self.n, dtype=float) + np.cumsum(add)
+        k = np.arange(self.n, dtype=float)
+        if self.gaps:
+            add = np.zeros(self.n)
+            for g in self.gaps:
+                add[g.index] += g.lost
+            k += np.cumsum(add)
+        return k
 
     def clock_times(self) -> np.ndarray | None:
         """Sample times [s] on the regular sensor clock, gaps included; None without a regular clock.
@@ -175,17 +179,9 @@ class TimeBase:
         if self.gaps:
             worst = max(self.gaps, key=lambda g: g.lost)
             lines.append(f"  {len(self.gaps)} gap(s), {self.lost} sample(s) missing; longest {worst.step * ms:.4g} ms "
-                         f"at sample {worst.index} ({worst.lost} lost): turns across a gap are left out")
+                         f"at sample {worst.index} ({worst.lost} lost): a turn across a gap keeps it as a bound on its angle, "
+                         "or is left out when that bound exceeds 1 %")
         return lines
-
-
-def _envelope(r: np.ndarray, size: int, forward: bool) -> np.ndarray:
-    """Running minimum of `r` over the `size` samples from i on (forward) or up to i (backward)."""
-    from scipy.ndimage import minimum_filter1d
-
-    # minimum_filter1d centres its window; `origin` shifts it to one side
-    origin = -(size // 2) if forward else (size - 1) // 2
-    return minimum_filter1d(r, size, mode="nearest", origin=origin)
 
 
 def _floor(x: np.ndarray) -> float:
@@ -194,32 +190,51 @@ def _floor(x: np.ndarray) -> float:
     return float(np.partition(x, k)[k])
 
 
-def _find_gaps(t: np.ndarray, step: np.ndarray, period: float) -> list[Gap]:
-    """Real gaps: long steps across which the lower envelope of the clock residual rises for good.
+def _block_size(period: float, n: int) -> int:
+    """Samples over which the least-delayed level is taken: 50, and at least half a second."""
+    return int(min(n, max(_ENVELOPE, round(_ENVELOPE_S / period))))
 
-    A vectorised pass keeps the long steps whose envelope rises by half a period. Each is then
-    confirmed by the least-delayed level (a low quantile, so that a few delayed samples at a
-    gap's edge do not count) just before and just after it, with the gaps already found taken
-    out: the longest steps first, then the shorter ones in time order, so that a burst's long
-    step right after a real gap is judged with that gap removed. A step must also be long
-    enough to hold the samples it lost.
+
+def _floors(r: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
+    """The least-delayed sample of each block of `size` (the last one may be short): values and indices."""
+    m = len(r) // size
+    at = r[: m * size].reshape(m, size).argmin(axis=1) + np.arange(m) * size
+    if m * size < len(r):
+        at = np.append(at, m * size + int(np.argmin(r[m * size:])))
+    return r[at], at
+
+
+def _find_gaps(r: np.ndarray, step: np.ndarray, period: float, floor: np.ndarray, size: int) -> list[Gap]:
+    """Real gaps: long steps across which the lower envelope of the clock residual `r` rises for good.
+
+    Blocks whose least-delayed level (`floor`, blocks of `size`) rises by half a period over the
+    block before hold the candidates. Each long step there is confirmed by the least-delayed level
+    (a low quantile, so that a few delayed samples at a gap's edge do not count) just before and
+    just after it, with the gaps already found taken out: the longest steps first, then the shorter
+    ones in time order, so that a burst's long step right after a real gap is judged with that gap
+    removed. A step must also be long enough to hold the samples it lost (counting the delay of
+    the sample before it, which shortens the step).
     """
-    candidates = np.flatnonzero(step > _CANDIDATE_STEP * period)
-    if not len(candidates):
+    rise = np.flatnonzero(np.diff(floor) >= 0.5 * period)
+    if not len(rise):
         return []
-    r = t - t[0] - period * np.arange(len(t))  # clock residual; its envelope is the least-delayed samples
-    size = min(_ENVELOPE, len(t))
-    jump = _envelope(r, size, forward=True)[candidates + 1] - _envelope(r, size, forward=False)[candidates]
-    likely = candidates[jump >= 0.5 * period]
+    candidates = np.flatnonzero(step > _CANDIDATE_STEP * period)
+    lo = np.searchsorted(candidates, rise * size)
+    hi = np.searchsorted(candidates, (rise + 2) * size)
+    likely = np.unique(np.concatenate([candidates[a:b] for a, b in zip(lo, hi)]))
     long_first = likely[step[likely] >= _LATE_STEP * period]
     order = np.concatenate([long_first[np.argsort(-step[long_first], kind="stable")],
                             likely[step[likely] < _LATE_STEP * period]])
-    lost_at = np.zeros(len(t))  # samples lost just before each sample, as found so far
+    n = len(r)
+    lost_at = np.zeros(n)  # samples lost just before each sample, as found so far
     for i in order.tolist():
-        lo, hi = max(0, i - size + 1), min(len(t), i + 1 + size)
+        lo, hi = max(0, i - size + 1), min(n, i + 1 + size)
         adj = r[lo:hi] - period * np.cumsum(lost_at[lo:hi])  # levels relative within the window
-        lost = int(np.rint((_floor(adj[i + 1 - lo:]) - _floor(adj[: i + 1 - lo])) / period))
-        if 1 <= lost <= int(np.rint(step[i] / period)):
+        before = _floor(adj[: i + 1 - lo])
+        lost = int(np.rint((_floor(adj[i + 1 - lo:]) - before) / period))
+        # the step from a late sample is short by that sample's delay: count it in the room
+        room = int(np.rint((step[i] + max(0.0, adj[i - lo] - before)) / period))
+        if 1 <= lost <= room:
             lost_at[i + 1] = lost
     found = np.flatnonzero(lost_at)
     return [Gap(int(j), float(step[j - 1]), int(lost_at[j])) for j in found]
@@ -241,20 +256,36 @@ def analyse_time(t, *, has_time: bool = True) -> TimeBase:
         raise InputError(f"a time base needs at least two sample times, got shape {t.shape}")
     step = np.diff(t)
     period = nominal_period(t)
-    gaps = _find_gaps(t, step, period)
-    regular = np.ones(len(step), dtype=bool)
-    regular[[g.index - 1 for g in gaps]] = False
-    kept = step[regular] if regular.any() else step
-    base = TimeBase(len(t), float(t[-1] - t[0]), period, 0.0, 0.0, 0.0, 0, tuple(gaps))
-    clock = _fit_clock(t, base.clock_numbers(), period)
-    sample = kept[np.linspace(0, len(kept) - 1, min(len(kept), 100_000)).astype(np.intp)]
+    # up to 20 000 evenly spread steps for the median and the jitter: exact enough, and cheap on long logs
+    sample = step[np.linspace(0, len(step) - 1, min(len(step), 20_000)).astype(np.intp)]
+    regular = float(step.max() - step.min()) <= 1e-9 * period * len(t)  # a clock's own stamps, up to rounding
+    gaps: list[Gap] = []
+    clock = (float(t[0]), float(t[-1] - t[0]) / (len(t) - 1))
+    if not regular:
+        r = t - t[0] - period * np.arange(len(t))  # clock residual; its lower envelope: the least-delayed samples
+        size = _block_size(period, len(t))
+        floor, at = _floors(r, size)
+        gaps = _find_gaps(r, step, period, floor, size)
+        k = None
+        if gaps:  # the envelope again, with the lost samples counted (a block may straddle a gap)
+            lost = np.zeros(len(t))
+            for g in gaps:
+                lost[g.index] = g.lost
+            lost = np.cumsum(lost)
+            floor, at = _floors(r - period * lost, size)
+            k = at + lost[at]
+        clock = _fit_clock(t, period, floor, at if k is None else k)
+        if gaps:
+            keep = np.ones(len(sample), dtype=bool)
+            keep[np.isin(np.linspace(0, len(step) - 1, len(sample)).astype(np.intp), [g.index - 1 for g in gaps])] = 0
+            sample = sample[keep] if keep.any() else sample
     return TimeBase(
         n=len(t),
         span=float(t[-1] - t[0]),
         period=period,
-        mean_step=float(step.mean()),
+        mean_step=float(t[-1] - t[0]) / (len(t) - 1),
         median_step=float(np.median(sample)),
-        jitter=float(kept.std()) if len(kept) > 1 else 0.0,
+        jitter=float(sample.std()) if len(sample) > 1 else 0.0,
         delayed=int(np.count_nonzero(step > _LATE_STEP * period)) - sum(g.step > _LATE_STEP * period for g in gaps),
         gaps=tuple(gaps),
         has_time=has_time,
@@ -264,20 +295,17 @@ def analyse_time(t, *, has_time: bool = True) -> TimeBase:
     )
 
 
-def _fit_clock(t: np.ndarray, k: np.ndarray, period: float) -> tuple[float, float] | None:
-    """``(start, period)`` of the regular clock under stamps `t` at clock numbers `k`, or None.
+def _fit_clock(t: np.ndarray, period: float, floor: np.ndarray, k: np.ndarray) -> tuple[float, float] | None:
+    """``(start, period)`` of the regular clock under stamps `t`, or None.
 
-    The lower envelope of ``t - k P`` (the least-delayed samples) is fitted by a line; the clock
-    is regular when the envelope stays within half a period of it.
+    The lower envelope of ``t - k P`` (`floor`: the least-delayed sample of each block, at clock
+    number `k`: its index plus the samples lost before it) is fitted by a line; the clock is
+    regular when the envelope stays within half a period of it.
     """
-    from scipy.ndimage import minimum_filter1d
-
-    r = t - t[0] - period * k
-    env = minimum_filter1d(r, min(_ENVELOPE, len(t)), mode="nearest")
-    pick = np.linspace(0, len(t) - 1, min(len(t), 10_000)).astype(np.intp)
-    slope, icept = np.polyfit(k[pick], env[pick], 1)
-    resid = env - (icept + slope * k)
+    if len(floor) < 2:
+        return float(t[0]), period
+    slope, icept = np.polyfit(k, floor, 1)
+    resid = floor - (icept + slope * k)
     if float(resid.max() - resid.min()) >= 0.5 * period:
         return None
     return float(t[0] + icept), float(period + slope)
-

@@ -86,6 +86,26 @@ gyrocal_status_t gyrocal_correct(const gyrocal_affine_t *cal, const float raw[3]
     return GYROCAL_OK;
 }
 
+gyrocal_status_t gyrocal_imu_correct(const gyrocal_imu_t *imu, const float gyro_raw[3], const float accel_raw[3],
+                                     float w_out[3], float a_out[3])
+{
+    float a[3], g[3];
+    int i;
+    if (imu == 0 || gyro_raw == 0 || accel_raw == 0 || w_out == 0 || a_out == 0) {
+        return GYROCAL_E_INPUT;
+    }
+    gyrocal_correct(&imu->accel, accel_raw, a);
+    for (i = 0; i < 3; ++i) {
+        /* the raw gyro less the part the specific force puts into it */
+        g[i] = gyro_raw[i] - (imu->g_sens[i][0] * a[0] + imu->g_sens[i][1] * a[1] + imu->g_sens[i][2] * a[2]);
+    }
+    gyrocal_correct(&imu->gyro, g, w_out);
+    for (i = 0; i < 3; ++i) {
+        a_out[i] = a[i];
+    }
+    return GYROCAL_OK;
+}
+
 gyrocal_status_t gyrocal_scale_bias_to_affine(const gyrocal_scale_bias_t *sb, gyrocal_affine_t *out)
 {
     int i, j;

@@ -63,6 +63,17 @@ typedef struct {
     float offset[3];
 } gyrocal_affine_t;
 
+/* A whole IMU (gyrocal imu): both sensors' corrections and the gyro's sensitivity to acceleration,
+ *     a_true = accel.matrix (accel_raw - accel.offset),
+ *     w_true = gyro.matrix (gyro_raw - gyro.offset - g_sens a_true);
+ * g_sens in gyro input units per accelerometer output unit, all zeros when none was fitted. */
+#define GYROCAL_CAL_HAS_IMU 1
+typedef struct {
+    gyrocal_affine_t gyro;
+    gyrocal_affine_t accel;
+    float g_sens[3][3];
+} gyrocal_imu_t;
+
 /* Parameters of the servo method of Wang et al.: g = diag(k) (m + b); b in the sensor's units, added to the reading. */
 typedef struct {
     float k[3];
@@ -103,6 +114,11 @@ typedef struct {
 /* w = matrix (raw - offset); out may be raw. NaN readings give NaN rates (checking each sample
  * would cost more than the correction). */
 gyrocal_status_t gyrocal_correct(const gyrocal_affine_t *cal, const float raw[3], float out[3]);
+
+/* Both sensors of a whole IMU (see gyrocal_imu_t): a_out first, then w_out with the g-sensitivity term;
+ * a_out and w_out may be the inputs. */
+gyrocal_status_t gyrocal_imu_correct(const gyrocal_imu_t *imu, const float gyro_raw[3], const float accel_raw[3],
+                                     float w_out[3], float a_out[3]);
 
 /* The canonical form of the servo method's parameters (Wang et al.): matrix = diag(k), offset = -b. */
 gyrocal_status_t gyrocal_scale_bias_to_affine(const gyrocal_scale_bias_t *sb, gyrocal_affine_t *out);

@@ -7,7 +7,9 @@ in float64 on the samples it recorded:
 1. **window means**: the host's mean of the turn's raw counts against the mean the device sent
    in its turn frame, within the accumulator's rounding bound;
 2. **the solve**: the host's first-moment solution from the device's own means and reference
-   rates against the device's ``k, b``, within the solver's rounding bound.
+   rates against the device's ``k, b``, within the solver's rounding bound;
+3. **corrected samples**: each corrected sample the device sent against ``k (m + b)`` of the raw
+   sample with the same sequence number, within the rounding of ``gyrocal_correct``.
 
 Each bound is a first-order float32 rounding bound, ``C_ROUND * eps`` times a componentwise
 (Skeel / Oettli-Prager) condition computed from the data: ``C_ROUND = 32`` covers rounding the
@@ -77,6 +79,10 @@ class Agreement:
         Worst ``|device mean - host mean| / bound`` over the six turns and three axes.
     missing : tuple of str
         Turns whose samples the host did not all receive (their means could not be checked).
+    corrected_ratio : float
+        Worst ``|w - k (m + b)| / bound`` over the corrected samples the device sent (0 when none).
+    corrected_n : int
+        How many corrected samples were checked.
     """
 
     device_k: np.ndarray
@@ -86,10 +92,12 @@ class Agreement:
     params_ratio: float
     means_ratio: float
     missing: tuple[str, ...] = ()
+    corrected_ratio: float = 0.0
+    corrected_n: int = 0
 
     @property
     def agrees(self) -> bool:
-        return self.params_ratio <= 1.0 and self.means_ratio <= 1.0
+        return max(self.params_ratio, self.means_ratio, self.corrected_ratio) <= 1.0
 
     def report(self, unit: str = "deg/s") -> str:
         lines = [f"{'':<4}{'device':>16} {'host, same turns':>17}"]
@@ -100,11 +108,20 @@ class Agreement:
         verdict = "agree" if self.agrees else "DISAGREE"
         lines.append(f"device and host {verdict} to float32 precision: worst difference {self.params_ratio:.2g} of its "
                      f"bound in k, b; {self.means_ratio:.2g} in the turn means"
-                     + (f" (means not checked for {', '.join(self.missing)}: samples missing)" if self.missing else ""))
+                     + (f" (means not checked for {', '.join(self.missing)}: samples missing)" if self.missing else "")
+                     + (f"; {self.corrected_ratio:.2g} in {self.corrected_n:,} corrected samples" if self.corrected_n
+                        else ""))
         return "\n".join(lines)
 
 
-def check_device(turns: dict[int, Turn], result: Result, samples: dict[int, np.ndarray] | None = None) -> Agreement:
+def corrected_bound(k, b, raw) -> np.ndarray:
+    """Bound on ``gyrocal_correct``'s float32 ``w = k (m + b)``: one subtraction and one product per axis."""
+    k, b = np.abs(np.asarray(k, float)), np.abs(np.asarray(b, float))
+    return C_ROUND * EPS32 * k * (np.abs(raw) + b)
+
+
+def check_device(turns: dict[int, Turn], result: Result, samples: dict[int, np.ndarray] | None = None,
+                 corrected: tuple[np.ndarray, np.ndarray] | None = None) -> Agreement:
     """Recompute the device's calibration on the host (see the module notes).
 
     Parameters
@@ -116,6 +133,8 @@ def check_device(turns: dict[int, Turn], result: Result, samples: dict[int, np.n
     samples : dict of int to ndarray, optional
         Slot -> the raw samples (n, 3) [counts] of that turn as the host recorded them, when the
         host has every one of them.
+    corrected : (ndarray, ndarray), optional
+        Raw samples (n, 3) [counts] and the corrected samples (n, 3) the device sent for them.
     """
     slots = range(len(TURN_LABELS))
     mean = np.array([turns[s].mean for s in slots], dtype=float)
@@ -134,5 +153,11 @@ def check_device(turns: dict[int, Turn], result: Result, samples: dict[int, np.n
             continue
         tol, _ = accumulator_bound(x)
         means_ratio = max(means_ratio, float(np.max(np.abs(mean[s] - x.mean(axis=0)) / tol)))
+    corrected_ratio, corrected_n = 0.0, 0
+    if corrected is not None and len(corrected[0]):
+        raw, w = (np.asarray(a, float) for a in corrected)
+        k, b = np.asarray(result.k, float), np.asarray(result.b, float)
+        corrected_ratio = float(np.max(np.abs(w - k * (raw + b)) / corrected_bound(k, b, raw)))
+        corrected_n = len(raw)
     return Agreement(np.array(result.k), np.array(result.b), fit.model.k, fit.model.b, params_ratio, means_ratio,
-                     tuple(missing))
+                     tuple(missing), corrected_ratio, corrected_n)

@@ -85,7 +85,22 @@ def device_check(result: CaptureResult) -> Agreement | None:
     if len(turns) < 6:
         return None
     samples = {s: result.store.samples_by_seq(t.start, t.stop) for s, t in turns.items()}
-    return check_device(turns, last, {s: x for s, x in samples.items() if x is not None})
+    return check_device(turns, last, {s: x for s, x in samples.items() if x is not None}, _corrected(result, last))
+
+
+def _corrected(result: CaptureResult, last: Result):
+    """Raw and corrected samples with the same sequence number, corrected by `last` (before a later result)."""
+    later = [r.seq for r in result.results if r.seq > last.seq]
+    end = min(later) if later else None
+    cal = [c for c in result.calibrated if c.seq >= last.seq and (end is None or c.seq < end)]
+    if not cal:
+        return None
+    seq = result.store.seq
+    idx = np.searchsorted(seq, [c.seq for c in cal])
+    ok = (idx < len(seq)) & (seq[np.minimum(idx, len(seq) - 1)] == [c.seq for c in cal])
+    raw = result.store.gyro[idx[ok]]
+    w = np.array([c.w for c, keep in zip(cal, ok) if keep]).reshape(-1, 3)
+    return raw, w
 
 
 def calibrate_capture(path: Path, *, units: str, sensitivity: float | None, sample_rate: float | None = None,

@@ -15,6 +15,9 @@ FLAGS: dict[str, str] = {
     "units": "--units",
     "columns": "--columns",
     "skip_rows": "--skip-rows",
+    # plan
+    "target_scale": "--target-scale",
+    "target_bias": "--target-bias",
     "sample_rate": "--sample-rate",
     "sensitivity": "--sensitivity",
     "output_units": "--output-units",
@@ -32,6 +35,14 @@ FLAGS: dict[str, str] = {
     "method": "--method",
     "noise_std": "--noise-std",
     "noise_density": "--noise-density",
+    # imu
+    "accel_model": "--accel-model",
+    "gyro_model": "--gyro-model",
+    "g_sensitivity": "--g-sensitivity",
+    "min_static": "--min-static",
+    "accel_output_units": "--accel-output-units",
+    "accel_log": "--accel-log",
+    "accel_columns": "--accel-columns",
     # apply, export
     "model": "--model",
     "out_of_range": "--out-of-range",
@@ -58,6 +69,12 @@ FLAGS: dict[str, str] = {
     "quantum": "--quantum",
     "bias_instability": "--bias-instability",
     "rate_random_walk": "--rrw",
+    # simulate --protocol multi-position, plan --design poses
+    "poses": "--poses",
+    "turn_deg": "--tilt",
+    "static_duration": "--still",
+    "stamps": "--stamps",
+    "gaps": "--gaps",
     # noise, thermal-bias, flight and VIO exports
     "imu": "--imu",
     "motion": "--motion",
@@ -91,6 +108,7 @@ FLAGS: dict[str, str] = {
     "ref_noise_std": "--ref-noise",
     "ref_units": "--ref-units",
     "ref_columns": "--ref-columns",
+    "ref_skip_rows": "--ref-skip-rows",
     "ref_sample_rate": "--ref-sample-rate",
     "ref_sensitivity": "--ref-sensitivity",
     "ref_topic": "--ref-topic",

@@ -9,6 +9,7 @@ makes a second set with a prefix (``ReadingFlags("ref-")`` gives ``--ref-units``
 from __future__ import annotations
 
 import contextlib
+import re
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -112,12 +113,20 @@ def read_from_flags(
 @contextlib.contextmanager
 def prefixed_params(prefix: str):
     """Errors raised inside the block name the prefixed flags: reading a reference log with
-    ``prefixed_params("ref_")``, a bad ``units`` shows as ``--ref-units`` (when that flag exists)."""
+    ``prefixed_params("ref_")``, a bad ``units`` shows as ``--ref-units``, and a hint's
+    ``{param:check_units}`` as ``--ref-no-unit-check`` (where those flags exist)."""
     from ._flags import FLAGS
+
+    def prefixed(name: str) -> str:
+        return f"{prefix}{name}" if f"{prefix}{name}" in FLAGS else name
 
     try:
         yield
     except GyrocalError as exc:
-        if exc.param is not None and f"{prefix}{exc.param}" in FLAGS:
-            exc.param = f"{prefix}{exc.param}"
+        if exc.param is not None:
+            exc.param = prefixed(exc.param)
+        other = re.compile(r"\{param:([A-Za-z_]\w*)\}")
+        exc.message = other.sub(lambda m: f"{{param:{prefixed(m.group(1))}}}", exc.message)
+        if exc.hint:
+            exc.hint = other.sub(lambda m: f"{{param:{prefixed(m.group(1))}}}", exc.hint)
         raise

@@ -105,8 +105,13 @@ def _is_usage_error(exc: BaseException) -> bool:
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
-    """A library warning as one ``warning:`` line."""
-    warn(str(message))
+    """A library warning as one ``warning:`` line. A numerical library's own warnings (numpy's
+    RuntimeWarning, ...) say nothing a user can act on: they show with ``--debug`` only; the test
+    suite turns every one of them into an error, so each is found and fixed at its source."""
+    if issubclass(category, GyrocalWarning):
+        warn(str(message))
+    elif _state["debug"]:
+        warn(f"{category.__name__}: {message} ({filename}:{lineno})")
 
 
 def message(exc: BaseException) -> str:

@@ -58,6 +58,7 @@ def apply(
                          f"corrected already, and {calibration.name} would correct them twice",
                          hint="give the raw recording, or --force to correct it again")
     unit = _unit(units, cal, calibration)
+    accel_units, gravity = _accel_reading(ctx, cal, accel_units, gravity)
     rec = read_from_flags(recording, units=unit, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
                           topic=topic, saturation=saturation, no_unit_check=no_unit_check, accel_units=accel_units,
                           accel_sensitivity=accel_sensitivity, gravity=gravity)
@@ -77,6 +78,16 @@ def apply(
     note = f"{_APPLIED} with {Path(calibration).name}; gx gy gz in {out_units}{accel}"
     write_recording(output, corrected, header_comment=note)
     console.print(f"wrote {output} ({len(corrected)} rows, gx gy gz in {out_units})", highlight=False)
+
+
+def _accel_reading(ctx, cal, accel_units: str | None, gravity: float) -> tuple[str | None, float]:
+    """A calibration with an accelerometer part reads ``ax, ay, az`` in its input unit and g by default."""
+    part = getattr(cal, "accelerometer", None)
+    if part is None or part.get("units") is None:
+        return accel_units, gravity
+    units = part["units"]
+    default_gravity = units.get("gravity") or gravity
+    return (accel_units or units.get("input"), gravity if given(ctx, "gravity") else default_gravity)
 
 
 def _unit(units: str | None, cal, calibration: Path) -> str:

@@ -12,10 +12,12 @@ from typing import Annotated, Optional
 
 import typer
 
-from ..choices import DeviceWire, Protocol
+from ..choices import DeviceWire, Protocol, TimeStamps
 from ..errors import InputError
 from ._options import NoiseDensity, given, noise_std, numbers, refuse_unused, triple
 from ._outputs import check_output, json_format, starts_with
+from ._sim_output import announce, output_unit, rate_flags, write_output
+from ._sim_runs import multi_position, profile_run, turntable, turntable_protocol
 from .app import app, console
 
 __all__ = ["simulate"]
@@ -24,35 +26,23 @@ _SIMULATED = "gyrocal simulate"  # first words of a simulated recording: a later
 _SERVO = ("servo", "hand")
 #: Flags that only some protocols use; the rest apply to every protocol.
 _PROTOCOL_FLAGS = {
-    **dict.fromkeys(("speed", "turns", "wait", "ramp", "misalignment"), _SERVO), "vibration": ("servo",),
+    **dict.fromkeys(("speed", "turns", "wait", "ramp", "revolutions"), _SERVO),
+    **dict.fromkeys(("vibration", "ripple", "ripple_freq"), ("servo",)),
+    "misalignment": (*_SERVO, "multi-position"),
     # the turntable gyro follows the full-temperature-range method's thermal truth
-    **dict.fromkeys(("k", "b"), (*_SERVO, "profile")),
+    **dict.fromkeys(("k", "b"), (*_SERVO, "profile", "multi-position")),
+    **dict.fromkeys(("poses", "tilt", "still"), ("multi-position",)),
     **dict.fromkeys(("temps", "rates", "step_duration"), ("turntable",)),
     **dict.fromkeys(("temp_noise", "temp_quantum"), ("turntable", "static")),
     **dict.fromkeys(("profile", "profile_units"), ("profile",)),
     "duration": ("profile", "static"),
-    **dict.fromkeys(("temp_start", "temp_end", "warmup_tau", "bias_tempco", "accel_noise_density",
-                     "accel_random_walk"), ("static",)),
+    **dict.fromkeys(("temp_start", "temp_end", "warmup_tau", "bias_tempco", "accel_random_walk"), ("static",)),
+    "accel_noise_density": ("static", "multi-position"),
     # a reference log needs turns about several axes, which the single-axis turntable does not make
     "reference": (*_SERVO, "profile"),
 }
 #: Flags that describe the reference log, so they need --reference.
 _REFERENCE_FLAGS = ("ref_sample_rate", "ref_offset", "ref_drift", "ref_mounting", "ref_noise", "ref_units")
-
-
-def _turntable_protocol(temps: str | None, rates: str | None, step_duration: float | None, temp_noise: float,
-                        temp_quantum: float | None):
-    """The full-temperature-range method's protocol; unset flags keep the paper's values."""
-    from ..simulation.turntable import TurntableProtocol
-
-    kw: dict = {}
-    if temps is not None:
-        kw["temps"] = tuple(numbers("--temps", temps))
-    if rates is not None:
-        kw["rates"] = tuple(numbers("--rates", rates))
-    if step_duration is not None:
-        kw["step_duration"] = step_duration
-    return TurntableProtocol(**kw, temp_noise=temp_noise, temp_quantum=temp_quantum)
 
 
 @app.command()
@@ -61,7 +51,9 @@ def simulate(
     output: Annotated[Path | None, typer.Option(
         "-o", "--output", help="Recording to write (CSV); the truth goes to *.truth.json (required, except with --device).")] = None,
     protocol: Annotated[Protocol, typer.Option("--protocol", help="Motion source.")] = "servo",
-    speed: Annotated[float, typer.Option("--speed", help="Servo/hand turn speed [deg/s].")] = 60.0,
+    speed: Annotated[Optional[str], typer.Option(
+        "--speed", help="Servo/hand turn speed, deg/s unless a unit is written, e.g. 1.05rad/s (default: 60 deg/s)."
+    )] = None,
     turns: Annotated[str, typer.Option("--turns", help="Turns, comma-separated.")] = "+x,-x,+y,-y,+z,-z",
     wait: Annotated[float, typer.Option("--wait", help="Static wait between turns [s].")] = 3.0,
     ramp: Annotated[float, typer.Option("--ramp", help="Acceleration ramp of each turn [s].")] = 0.3,
@@ -70,13 +62,26 @@ def simulate(
     k: Annotated[Optional[str], typer.Option(
         "--k", help="True scale factors kx,ky,kz (the servo method of Wang et al., eq. 1) (default: 1,1,1).")] = None,
     b: Annotated[Optional[str], typer.Option(
-        "--b", help="True biases bx,by,bz [rad/s] (the servo method of Wang et al., eq. 1) (default: 0,0,0).")] = None,
-    noise: Annotated[Optional[float], typer.Option("--noise", help="Per-sample white noise [rad/s] (default: 0.035, the paper's; 0.005 for the turntable).")] = None,
+        "--b", help="True biases bx,by,bz (the servo method of Wang et al., eq. 1), rad/s unless a unit is written "
+                    "after them, e.g. 0.5,-0.2,0.1deg/s (default: 0,0,0).")] = None,
+    noise: Annotated[Optional[str], typer.Option(
+        "--noise", help="Per-sample white noise, rad/s unless a unit is written, e.g. 2deg/s (default: 0.035 rad/s, "
+                        "the paper's; 0.005 rad/s for the turntable and static).")] = None,
     noise_density: NoiseDensity = None,
-    bias_instability: Annotated[float, typer.Option("--bias-instability", help="Gauss-Markov bias std [rad/s].")] = 0.0,
-    rate_random_walk: Annotated[float, typer.Option("--rrw", help="Rate random walk [rad/s/sqrt(s)].")] = 0.0,
-    quantum: Annotated[Optional[float], typer.Option("--quantum", help="Output resolution [rad/s] (default: none, not quantised).")] = None,
-    full_scale: Annotated[Optional[float], typer.Option("--full-scale", help="Saturation [deg/s] (default: none, never saturates).")] = None,
+    bias_instability: Annotated[Optional[str], typer.Option(
+        "--bias-instability", help="Gauss-Markov bias std, rad/s unless a unit is written (default: 0).")] = None,
+    rate_random_walk: Annotated[Optional[str], typer.Option(
+        "--rrw", help="Rate random walk per sqrt(s), rad/s/sqrt(s) unless deg/s is written (default: 0).")] = None,
+    quantum: Annotated[Optional[str], typer.Option(
+        "--quantum", help="Output resolution, rad/s unless a unit is written (default: none, not quantised).")] = None,
+    full_scale: Annotated[Optional[str], typer.Option(
+        "--full-scale", help="Saturation, deg/s unless a unit is written (default: none, never saturates).")] = None,
+    poses: Annotated[int, typer.Option(
+        "--poses", help="--protocol multi-position: still poses of the hand session.")] = 24,
+    tilt: Annotated[float, typer.Option(
+        "--tilt", help="--protocol multi-position: tilt between successive poses [deg].")] = 90.0,
+    still: Annotated[float, typer.Option(
+        "--still", help="--protocol multi-position: still time in each pose [s] (each drawn within +-25 %).")] = 3.0,
     profile: Annotated[Optional[Path], typer.Option("--profile", help="--protocol profile: CSV of t,wx,wy,wz (required there).")] = None,
     profile_units: Annotated[str, typer.Option("--profile-units", help="Unit of the profile rates.")] = "rad/s",
     duration: Annotated[Optional[float], typer.Option(
@@ -94,7 +99,8 @@ def simulate(
                               "no temperature dependence).")] = None,
     accel_noise_density: Annotated[Optional[float], typer.Option(
         "--accel-noise-density", help="--protocol static: also an accelerometer (gravity on z), white noise "
-                                      "[m/s^2/sqrt(Hz)] (default: none, no accelerometer).")] = None,
+                                      "[m/s^2/sqrt(Hz)] (default: none, no accelerometer); --protocol "
+                                      "multi-position: the accelerometer's noise (default: 0.002).")] = None,
     accel_random_walk: Annotated[Optional[float], typer.Option(
         "--accel-random-walk", help="--protocol static: accelerometer bias random walk [m/s^3/sqrt(Hz)] (default: "
                                     "none, no accelerometer; 0 with --accel-noise-density).")] = None,
@@ -112,8 +118,27 @@ def simulate(
     temp_quantum: Annotated[Optional[float], typer.Option(
         "--temp-quantum", help="--protocol turntable, static: resolution of the temperature readings [degC], e.g. 1 (default: none, not quantised).")]
     = None,
+    revolutions: Annotated[Optional[str], typer.Option(
+        "--revolutions", help="Servo/hand: revolutions of each turn, one number or one per turn (0.375,0.5,0.75 = "
+                              "135, 180, 270 deg). Default: 1.")] = None,
+    ripple: Annotated[float, typer.Option(
+        "--ripple", help="Servo: sinusoidal speed ripple, amplitude as a fraction of the speed (0.05 = 5 %).")] = 0.0,
+    ripple_freq: Annotated[float, typer.Option("--ripple-freq", help="Servo: frequency of the ripple [Hz].")] = 2.5,
+    stamps: Annotated[TimeStamps, typer.Option(
+        "--stamps", help="Time stamps: the sensor's clock, or receive times of a PC reading packets of two samples "
+                         "(steps of about 3 and 17 ms at 100 Hz).")] = "sensor",
+    late_per_minute: Annotated[float, typer.Option(
+        "--late-per-minute", help="--stamps receive: late packets per minute (a long step caught up by a burst; "
+                                  "nothing lost).")] = 0.0,
+    gaps: Annotated[int, typer.Option("--gaps", help="Packet gaps: runs of samples never delivered.")] = 0,
+    gap_length: Annotated[float, typer.Option("--gap-length", help="Length of each gap [s].")] = 0.17,
     sample_rate: Annotated[float, typer.Option("--sample-rate", help="Sampling rate [Hz].")] = 200.0,
-    units: Annotated[str, typer.Option("--units", help="Unit of the written gyro columns.")] = "deg/s",
+    units: Annotated[str, typer.Option(
+        "--units", help="Unit of the written gyro columns: deg/s, rad/s, or counts with --sensitivity.",
+        metavar="<deg/s|rad/s|counts>")] = "deg/s",
+    sensitivity: Annotated[Optional[float], typer.Option(
+        "--sensitivity", help="--units counts: LSB per deg/s of the written integers, e.g. 131 for an MPU-9250 at "
+                              "+-250 deg/s (required there; add --full-scale to clip at the sensor's range).")] = None,
     seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
     reference: Annotated[Optional[Path], typer.Option(
         "--reference", help="Also write the log of a reference gyro on the same motion (its own clock, mount, rate "
@@ -142,7 +167,8 @@ def simulate(
     pace: Annotated[float, typer.Option(
         "--pace", help="--device: 1 = real time, 10 = ten times faster, 0 = as fast as the reader reads.")] = 1.0,
 ) -> None:
-    """Simulate a recording (servo, hand, turntable, profile or static) with its truth sidecar."""
+    """Simulate a recording (servo, hand, turntable, profile, static, or a whole IMU's multi-position hand
+    session) with its truth sidecar."""
     import numpy as np
 
     from ..files import save
@@ -152,43 +178,48 @@ def simulate(
     from ..units import parse_rate_unit
 
     refuse_unused(ctx, _PROTOCOL_FLAGS, protocol, "--protocol")
+    speed, noise, bias_instability, rate_random_walk, quantum, full_scale, b = rate_flags(
+        speed, noise, bias_instability, rate_random_walk, quantum, full_scale, b)
     _refuse_reference_flags(ctx, reference)
     if device and reference is not None:
         raise InputError("--reference writes a second log; it does not go with --device (leave one out)")
     if device:
         return _serve_device(protocol, speed, turns, wait, misalignment, k, b, noise, noise_density, sample_rate,
                              seed, wire, faults, pace)
-    for name in ("wire", "faults", "pace"):
-        if given(ctx, name):
-            raise InputError(f"--{name} is for --device only; add --device or leave --{name} out")
+    _refuse_device_flags(ctx)
     truth_file = _check_outputs(output, truth_path(output) if output else None, reference, profile, force)
-    unit = parse_rate_unit(units)
+    unit = output_unit(units, sensitivity)
     rng = np.random.default_rng(seed)
     sd = noise_std(noise, noise_density, sample_rate, 0.035 if protocol not in ("turntable", "static") else 0.005)
-    model = ScaleBias(triple("--k", k, (1.0, 1.0, 1.0)), triple("--b", b, (0.0, 0.0, 0.0)))
+    model = ScaleBias(triple("--k", k, (1.0, 1.0, 1.0)), b)
     gyro_kw = dict(noise_std=tuple(sd), bias_instability=bias_instability, rate_random_walk=rate_random_walk,
                    quantum=quantum, full_scale=None if full_scale is None else math.radians(full_scale))
     settings = {"sample_rate": sample_rate, "noise_std": sd.tolist(), "bias_instability": bias_instability,
                 "rate_random_walk": rate_random_walk, "quantum": quantum, "full_scale_deg_s": full_scale,
                 "seed": seed, "units": unit}
+    size = announce(protocol, ctx.params, sample_rate, temps, rates, step_duration, unit, console)
     if protocol in _SERVO:
         rec, facts, true_rates = _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misalignment,
-                                        sample_rate, rng, settings)
+                                        sample_rate, rng, settings, revolutions=revolutions, ripple=ripple,
+                                        ripple_freq=ripple_freq)
+    elif protocol == "multi-position":
+        rec, model, facts = multi_position(model, gyro_kw, ctx.params, sample_rate, rng, settings)
     elif protocol == "turntable":
-        rec, model, facts = _turntable(gyro_kw, _turntable_protocol(temps, rates, step_duration, temp_noise,
+        rec, model, facts = turntable(gyro_kw, turntable_protocol(temps, rates, step_duration, temp_noise,
                                                                      temp_quantum), sample_rate, rng, settings)
     elif protocol == "static":
         rec, facts = _static(gyro_kw, ctx.params, sample_rate, rng, settings)
     else:
-        rec, facts, true_rates = _profile(model, gyro_kw, profile, profile_units, duration, sample_rate, rng,
+        rec, facts, true_rates = profile_run(model, gyro_kw, profile, profile_units, duration, sample_rate, rng,
                                           settings)
     ref_rec = None
     if reference is not None:
         ref_rec, facts["reference"] = _reference_log(rec.t, true_rates, reference, rng, sample_rate=ref_sample_rate,
                                                      offset=ref_offset, drift=ref_drift, mounting=ref_mounting,
                                                      noise=ref_noise)
-    write_recording(output, rec, units=unit,
-                    header_comment=f"{_SIMULATED} --protocol {protocol}; gyro in {unit}, t in s")
+    if stamps == "receive" or gaps or given(ctx, "late_per_minute"):
+        rec, facts = _time_defects(rec, facts, settings, stamps, late_per_minute, gaps, gap_length, reference, rng)
+    write_output(output, rec, unit, sensitivity, settings, f"{_SIMULATED} --protocol {protocol}", large=bool(size))
     if ref_rec is not None:
         ref_unit = parse_rate_unit(ref_units, "ref_units")
         write_recording(reference, ref_rec, units=ref_unit,
@@ -214,6 +245,13 @@ def _check_outputs(output: Path | None, truth_file: Path | None, reference: Path
         check_output(reference, flag="--reference", inputs=(profile, output, truth_file), force=force,
                      replaceable=starts_with(f"# {_SIMULATED}"))
     return truth_file
+
+
+def _refuse_device_flags(ctx: typer.Context) -> None:
+    """--wire, --faults and --pace describe a served device: refuse them without --device."""
+    for name in ("wire", "faults", "pace"):
+        if given(ctx, name):
+            raise InputError(f"--{name} is for --device only; add --device or leave --{name} out")
 
 
 def _refuse_reference_flags(ctx: typer.Context, reference: Path | None) -> None:
@@ -243,6 +281,20 @@ def _reference_log(t, true_rates, path: Path, rng, *, sample_rate: float, offset
     return rec, {"path": path.name, **truth.to_dict()}
 
 
+def _time_defects(rec, facts, settings, stamps, late_per_minute, gaps, gap_length, reference, rng):
+    """Receive-time stamps and packet gaps (:func:`gyrocal.simulation.timestamps.simulate_time_defects`)."""
+    from ..simulation.timestamps import simulate_time_defects
+
+    if stamps != "receive" and late_per_minute:
+        raise InputError("--late-per-minute is for --stamps receive; add it or leave --late-per-minute out")
+    if reference is not None:
+        raise InputError("--reference is written on the true clock; give it or --stamps receive/--gaps, not both")
+    rec, facts, more = simulate_time_defects(rec, facts, rng, stamps=stamps, late_per_minute=late_per_minute,
+                                             gaps=gaps, gap_length=gap_length)
+    settings.update(more)
+    return rec, facts
+
+
 def _serve_device(protocol, speed, turns, wait, misalignment, k, b, noise, noise_density, sample_rate, seed, wire,
                   faults, pace) -> None:
     """``simulate --device``: a simulated session served on a pseudo-terminal until it is read to the end."""
@@ -262,7 +314,7 @@ def _serve_device(protocol, speed, turns, wait, misalignment, k, b, noise, noise
     kw = dict(speed=math.radians(speed), wait=wait, misalignment_deg=misalignment, lead_in=3.0)
     proto = ServoProtocol.hand(turn_list, **kw) if protocol == "hand" else ServoProtocol(turns=turn_list, **kw)
     sd = noise_std(noise, noise_density, sample_rate, 0.01)
-    model = ScaleBias(triple("--k", k, (1.0, 1.0, 1.0)), triple("--b", b, (0.0, 0.0, 0.0)))
+    model = ScaleBias(triple("--k", k, (1.0, 1.0, 1.0)), b)
     session = simulate_device_session(proto, model=model, noise_std=sd, rng=np.random.default_rng(seed),
                                       sample_rate=sample_rate)
     data, _ = damage(device_bytes(session, wire), fault)
@@ -278,53 +330,24 @@ def _serve_device(protocol, speed, turns, wait, misalignment, k, b, noise, noise
     console.print(f"sent {dev.sent:,} bytes; the device closed the link", highlight=False)
 
 
-def _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misalignment, sample_rate, rng, settings):
+def _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misalignment, sample_rate, rng, settings,
+           *, revolutions: str | None = None, ripple: float = 0.0, ripple_freq: float = 2.5):
     """A servo or hand session: the recording, its facts and true rates; `settings` gains the protocol's."""
     from ..simulation import VirtualGyro
     from ..simulation.servo import ServoProtocol, simulate_servo
     from ..simulation.truth import servo_facts
 
     turn_list = tuple(t.strip() for t in turns.split(",") if t.strip())
-    kw = dict(speed=math.radians(speed), wait=wait, ramp=ramp, misalignment_deg=misalignment)
+    revs = (1.0,) if revolutions is None else tuple(numbers("--revolutions", revolutions))
+    kw = dict(speed=math.radians(speed), wait=wait, ramp=ramp, misalignment_deg=misalignment,
+              revolutions=revs[0] if len(revs) == 1 else revs)
     proto = (ServoProtocol.hand(turn_list, **kw) if protocol == "hand"
-             else ServoProtocol(turns=turn_list, vibration=vibration, **kw))
+             else ServoProtocol(turns=turn_list, vibration=vibration, ripple=ripple, ripple_freq=ripple_freq, **kw))
     rec, truth = simulate_servo(VirtualGyro(model, **gyro_kw), proto, sample_rate=sample_rate, rng=rng)
     settings.update(speed_deg_s=speed, turns=list(turn_list), wait_s=wait, ramp_s=ramp, vibration=vibration,
-                    misalignment_deg=misalignment)
+                    misalignment_deg=misalignment, revolutions=[float(r) for r in proto.turn_angles() / (2 * math.pi)],
+                    ripple=ripple, ripple_freq_hz=ripple_freq)
     return rec, servo_facts(truth), truth.rates
-
-
-def _turntable(gyro_kw, proto, sample_rate, rng, settings):
-    """A turntable session of a gyro following the thermal truth: recording, model at 25 degC, facts."""
-    import numpy as np
-
-    from ..models import Affine
-    from ..simulation import VirtualGyro
-    from ..simulation.thermal_truth import ThermalTruth
-    from ..simulation.turntable import simulate_turntable
-
-    thermal = ThermalTruth()
-    K, B = thermal(np.array([thermal.ref_temp]))
-    model = Affine(K[0], B[0])
-    rec = simulate_turntable(VirtualGyro(model, thermal=thermal, **gyro_kw), proto, sample_rate=sample_rate, rng=rng)
-    settings.update(temps_degC=list(proto.temps), rates_deg_s=list(proto.rates), axes=list(proto.axes),
-                    step_duration_s=proto.step_duration, table_tau_s=proto.table_tau,
-                    temp_noise_degC=proto.temp_noise, temp_quantum_degC=proto.temp_quantum)
-    return rec, model, {"thermal": thermal.to_dict()}
-
-
-def _profile(model, gyro_kw, profile, profile_units, duration, sample_rate, rng, settings):
-    """A recording of a rate profile read from a CSV file."""
-    from ..io import read_profile
-    from ..simulation import VirtualGyro
-    from ..simulation.profiles import simulate_profile
-
-    if profile is None or duration is None:
-        raise InputError("--protocol profile needs --profile FILE.csv and --duration SECONDS")
-    rec, true_rates = simulate_profile(VirtualGyro(model, **gyro_kw), read_profile(profile, units=profile_units),
-                                       duration=duration, sample_rate=sample_rate, rng=rng)
-    settings.update(profile=str(profile), duration_s=duration)
-    return rec, {}, true_rates
 
 
 def _static(gyro_kw, flags: dict, sample_rate, rng, settings):
@@ -357,3 +380,4 @@ def _static(gyro_kw, flags: dict, sample_rate, rng, settings):
                            "noise_density": accel.noise_density, "random_walk": accel.random_walk,
                            "gravity": [0.0, 0.0, 9.80665]}}}
     return rec, facts
+

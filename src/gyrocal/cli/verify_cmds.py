@@ -27,6 +27,8 @@ __all__ = ["compare", "verify"]
 REF = ReadingFlags("ref-")
 #: Files ``verify`` writes into its folder (rewritten on every run).
 OUTPUTS = ("verify.json", "summary.md", "before.png", "after.png", "errors.png")
+EXAMPLE_TEST = "example_servo_repeat.csv"  # tools/make_example.py: the testing period
+EXAMPLE_REFERENCE = "example_servo_reference.csv"
 
 
 def _stretch(text: str | None) -> tuple[float, float] | None:
@@ -42,29 +44,35 @@ def _stretch(text: str | None) -> tuple[float, float] | None:
     return lo, hi
 
 
-def _read_test(path: Path, cal, units, columns, sample_rate, topic, saturation, no_unit_check):
-    """The test log in the calibration's input units (counts with its sensitivity, when it has one)."""
+def _read_test(path: Path, cal, units, columns, skip_rows, sample_rate, topic, saturation, no_unit_check):
+    """The test log: rates in any rate unit (they are physical), or counts for a counts calibration,
+    with its sensitivity when it has one (so the raw rates before calibration are known)."""
     from ..units import parse_input_unit
 
-    expected = cal.input_units
-    if units is not None and parse_input_unit(units, "units") != expected:
-        raise InputError(f"--units {units} does not match the calibration's input units {expected}; the "
-                         f"calibration applies to data in {expected}", param="units")
-    sensitivity = getattr(cal, "sensitivity", None) if expected == "counts" else None
-    return read_from_flags(path, units=expected, columns=columns, sample_rate=sample_rate, sensitivity=sensitivity,
-                           output_units=cal.output_units if sensitivity is not None else None, topic=topic,
+    unit = cal.input_units if units is None else parse_input_unit(units, "units")
+    sensitivity = getattr(cal, "sensitivity", None)
+    if unit == "counts" and cal.input_units != "counts":
+        raise InputError(f"the calibration applies to rates in {cal.input_units}, not to raw counts", param="units",
+                         hint=f"give {{param}} {cal.input_units} (or any rate unit) for the test log")
+    if unit != "counts" and cal.input_units == "counts" and sensitivity is None:
+        raise InputError("the calibration works on raw counts without a sensitivity", param="units",
+                         hint="read the test log as {param} counts")
+    return read_from_flags(path, units=unit, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
+                           sensitivity=sensitivity if unit == "counts" else None,
+                           output_units=cal.output_units if unit == "counts" and sensitivity else None, topic=topic,
                            saturation=saturation, no_unit_check=no_unit_check)
 
 
-def _read_reference(path: Path, units, columns, sample_rate, sensitivity, topic, saturation, no_unit_check):
+def _read_reference(path: Path, units, columns, skip_rows, sample_rate, sensitivity, topic, saturation, no_unit_check):
     """The reference log in rates; its flags carry the prefix ``--ref-`` in every message."""
     with prefixed_params("ref_"):
         unit = required_units(units)
         if unit == "counts" and sensitivity is None:
             raise InputError("the reference log is in counts; its rates are needed", param="sensitivity",
                              hint="give {param} in LSB per deg/s")
-        return read_from_flags(path, units=unit, columns=columns, sample_rate=sample_rate, sensitivity=sensitivity,
-                               topic=topic, saturation=saturation, no_unit_check=no_unit_check)
+        return read_from_flags(path, units=unit, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
+                               sensitivity=sensitivity, topic=topic, saturation=saturation,
+                               no_unit_check=no_unit_check)
 
 
 def _print_report(report) -> None:
@@ -114,21 +122,36 @@ def _write_outputs(folder: Path, report, series, stretch, figures: bool) -> list
     return written
 
 
+def _example(test: Path | None, reference: Path | None) -> tuple[Path, Path]:
+    """The bundled testing period of the example and its reference log."""
+    from importlib import resources
+
+    if test is not None or reference is not None:
+        raise InputError("give TEST and --reference, or --example for the bundled pair, not both")
+    data = resources.files("gyrocal") / "data"
+    return Path(str(data / EXAMPLE_TEST)), Path(str(data / EXAMPLE_REFERENCE))
+
+
 @app.command()
 def verify(
     ctx: typer.Context,
     calibration: Annotated[Path, typer.Argument(help="A gyrocal calibration or thermal calibration file.")],
-    test: Annotated[Path, typer.Argument(help="Log of the calibrated gyro (raw readings) during the motion.")],
-    reference: Annotated[Path, typer.Option("--reference", help="Log of the reference gyro during the same motion.")],
-    output: Annotated[Path, typer.Option("-o", "--output", help="Folder for verify.json, summary.md and figures.")],
-    units: READING.Units = None,
+    test: Annotated[Optional[Path], typer.Argument(
+        help="Log of the calibrated gyro (raw readings) during the motion (required unless --example).")] = None,
+    reference: Annotated[Optional[Path], typer.Option(
+        "--reference", help="Log of the reference gyro during the same motion (required unless --example).")] = None,
+    output: Annotated[Path, typer.Option("-o", "--output", help="Folder for verify.json, summary.md and figures.")]
+    = Path("verify"),
+    units: READING.UnitsOfCalibration = None,
     columns: READING.Columns = None,
+    skip_rows: READING.SkipRows = None,
     sample_rate: READING.SampleRate = None,
     topic: READING.Topic = None,
     saturation: READING.Saturation = "error",
     no_unit_check: READING.NoUnitCheck = False,
     ref_units: REF.Units = None,
     ref_columns: REF.Columns = None,
+    ref_skip_rows: REF.SkipRows = None,
     ref_sample_rate: REF.SampleRate = None,
     ref_sensitivity: REF.Sensitivity = None,
     ref_topic: REF.Topic = None,
@@ -147,19 +170,30 @@ def verify(
     = True,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the bootstrap.")] = 0,
     replicates: Annotated[int, typer.Option("--replicates", help="Bootstrap replicates.", min=50)] = 1000,
+    example: Annotated[bool, typer.Option(
+        "--example", help="Use the bundled testing period of the example (the servo method of Wang et al.'s "
+                          "MPU9250, repeating its turns) and its reference log (deg/s, 100 Hz, own clock).")] = False,
 ) -> None:
     """Check a calibration against a reference gyro that recorded the same motion (two clocks, two mounts)."""
     from ..files import load
     from ..verify import verify_calibration
 
+    if example:
+        test, reference = _example(test, reference)
+        units, ref_units = units or "deg/s", ref_units or "deg/s"
+        console.print(f"example: {test.name} with the reference {reference.name}\n  same as: gyrocal verify "
+                      f"{calibration} {test} --reference {reference} --ref-units deg/s -o {output}", highlight=False,
+                      soft_wrap=True)
+    if test is None or reference is None:
+        raise InputError("give the test log and --reference REF (or --example for the bundled pair)")
     check_output(output, folder=True, inputs=(calibration, test, reference))
     span = _stretch(stretch)
     cal = load(calibration)
     if not callable(getattr(cal, "apply", None)):
         raise InputError(f"{calibration} holds a {cal.FORMAT} file; verify needs a calibration or thermal file")
-    rec = _read_test(test, cal, units, columns, sample_rate, topic, saturation, no_unit_check)
-    ref = _read_reference(reference, ref_units, ref_columns, ref_sample_rate, ref_sensitivity, ref_topic,
-                          ref_saturation, ref_no_unit_check)
+    rec = _read_test(test, cal, units, columns, skip_rows, sample_rate, topic, saturation, no_unit_check)
+    ref = _read_reference(reference, ref_units, ref_columns, ref_skip_rows, ref_sample_rate, ref_sensitivity,
+                          ref_topic, ref_saturation, ref_no_unit_check)
     options = {name: value for name, value in (("model", model), ("out_of_range", out_of_range)) if given(ctx, name)}
     inputs = {"calibration": calibration.name, "test": test.name, "reference": reference.name}
     report, series = verify_calibration(cal, rec, ref, seed=seed, fit_drift=not no_drift, replicates=replicates,

@@ -111,14 +111,51 @@ def calibration_header(cal, *, prefix: str = "gyrocal") -> str:
            else f", per-sample noise std {np.round(cal.noise_std, 6).tolist()} {cal.internal_units}")
         + ".",
     ]
-    rows = ",\n".join(f"        {_c_vector(row)}" for row in matrix)
+    body = f"static const gyrocal_affine_t {name} = {_affine_literal(matrix, offset, 4)};\n"
+    if cal.accelerometer is not None and cal.accelerometer.get("correction") is not None:
+        imu_comment, imu_body = _imu_part(cal, c_prefix(prefix), matrix, offset)
+        comment += ["", *imu_comment]
+        body += "\n" + imu_body
+    return _header(name, comment, cal.input_units, cal.output_units, body)
+
+
+def _affine_literal(matrix, offset, indent: int) -> str:
+    """``{{rows}, offset}`` of a gyrocal_affine_t, the rows indented by `indent` + 4 spaces."""
+    pad = " " * indent
+    rows = ",\n".join(f"{pad}    {_c_vector(row)}" for row in np.asarray(matrix))
+    return f"{{\n{pad}{{\n{rows}\n{pad}}},\n{pad}{_c_vector(offset)}\n{pad[:-4]}}}"
+
+
+def _imu_part(cal, upper: str, matrix, offset) -> tuple[list[str], str]:
+    """Comment lines and the ``<PREFIX>_IMU`` definition (a gyrocal_imu_t) of a whole-IMU calibration."""
+    part = cal.accelerometer
+    units, corr = part["units"], part["correction"]
+    a_matrix, a_offset = np.asarray(corr["matrix"], float), np.asarray(corr["offset"], float)
+    coupling = part.get("gyro_g_sensitivity")
+    per_out = 1.0 if units["output"] == "m/s^2" else float(units["gravity"])  # G is per m/s^2 in the file
+    g_sens = np.zeros((3, 3)) if coupling is None else np.asarray(coupling["matrix"], float) * per_out
+    name = f"{upper}_IMU"
+    comment = [
+        f"Whole IMU (gyrocal imu): gyrocal_imu_correct(&{name}, gyro_raw, accel_raw, w_true, a_true)",
+        f"  a_true = accel.matrix @ (accel_raw - accel.offset): accel_raw in {units['input']}, a_true in "
+        f"{units['output']} (g = {units['gravity']:g} m/s^2);",
+        f"  w_true = gyro.matrix @ (gyro_raw - gyro.offset - g_sens @ a_true): g_sens in {cal.input_units} per "
+        f"{units['output']}" + (" (none fitted: zeros)." if coupling is None else "."),
+        f"  Accelerometer model {part.get('model', 'given')}, its parameters and 1-sigma in the calibration file.",
+    ]
     body = (
-        f"static const gyrocal_affine_t {name} = {{\n"
-        + f"    {{\n{rows}\n    }},\n"
-        + f"    {_c_vector(offset)}\n"
+        "#ifndef GYROCAL_CAL_HAS_IMU\n"
+        + f'#error "{name}: needs a gyrocal_cal.h with gyrocal_imu_correct; take the one of this gyrocal"\n'
+        + "#endif\n"
+        + f'#define {name}_ACCEL_INPUT_UNITS "{units["input"]}"\n'
+        + f'#define {name}_ACCEL_OUTPUT_UNITS "{units["output"]}"\n'
+        + f"static const gyrocal_imu_t {name} = {{\n"
+        + f"    {_affine_literal(matrix, offset, 8)},\n"
+        + f"    {_affine_literal(a_matrix, a_offset, 8)},\n"
+        + "    {\n" + ",\n".join(f"        {_c_vector(row)}" for row in g_sens) + "\n    }\n"
         + "};\n"
     )
-    return _header(name, comment, cal.input_units, cal.output_units, body)
+    return comment, body
 
 
 def thermal_header(tc, *, prefix: str = "gyrocal") -> str:

@@ -118,6 +118,10 @@ class _Affine(ctypes.Structure):
     _fields_ = [("matrix", _F3 * 3), ("offset", _F3)]
 
 
+class _Imu(ctypes.Structure):
+    _fields_ = [("gyro", _Affine), ("accel", _Affine), ("g_sens", _F3 * 3)]
+
+
 class _ScaleBias(ctypes.Structure):
     _fields_ = [("k", _F3), ("b", _F3)]
 
@@ -138,6 +142,8 @@ class _Obs(ctypes.Structure):
 _P = ctypes.POINTER
 _SIGNATURES = {
     "gyrocal_correct": (ctypes.c_int, [_P(_Affine), _P(ctypes.c_float), _P(ctypes.c_float)]),
+    "gyrocal_imu_correct": (ctypes.c_int, [_P(_Imu), _P(ctypes.c_float), _P(ctypes.c_float), _P(ctypes.c_float),
+                                           _P(ctypes.c_float)]),
     "gyrocal_scale_bias_to_affine": (ctypes.c_int, [_P(_ScaleBias), _P(_Affine)]),
     "gyrocal_thermal_correct": (ctypes.c_int, [_P(_Thermal), ctypes.c_float, _P(ctypes.c_float), ctypes.c_uint,
                                                _P(ctypes.c_float)]),
@@ -194,6 +200,22 @@ class CLibrary:
         for i in range(len(m)):
             self._check(self.dll.gyrocal_correct(ctypes.byref(cal), _ptr(m[i]), _ptr(out[i])), "correction")
         return out
+
+    def imu_correct(self, gyro, accel, g_sens, gyro_raw, accel_raw) -> tuple[np.ndarray, np.ndarray]:
+        """``gyrocal_imu_correct`` on every row; `gyro` and `accel` are ``(matrix, offset)`` pairs,
+        `g_sens` (3, 3); returns the corrected rates and accelerations (N, 3) each."""
+        imu = _Imu()
+        for part, (matrix, offset) in ((imu.gyro, gyro), (imu.accel, accel)):
+            ctypes.memmove(part.matrix, _f32("matrix", matrix, (3, 3)).ctypes.data, 36)
+            ctypes.memmove(part.offset, _f32("offset", offset, (3,)).ctypes.data, 12)
+        ctypes.memmove(imu.g_sens, _f32("g_sens", g_sens, (3, 3)).ctypes.data, 36)
+        g, a = _f32("gyro_raw", gyro_raw, (3,)).reshape(-1, 3), _f32("accel_raw", accel_raw, (3,)).reshape(-1, 3)
+        w_out, a_out = np.empty_like(g), np.empty_like(a)
+        for i in range(len(g)):
+            status = self.dll.gyrocal_imu_correct(ctypes.byref(imu), _ptr(g[i]), _ptr(a[i]), _ptr(w_out[i]),
+                                                  _ptr(a_out[i]))
+            self._check(status, "whole-IMU correction")
+        return w_out, a_out
 
     def thermal_correct(self, temps, kg, temp, raw, clamp: bool = False) -> np.ndarray:
         """``gyrocal_thermal_correct`` on every row of `raw` (N, 3) at temperatures `temp` (N,) [degC]."""

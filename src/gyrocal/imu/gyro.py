@@ -57,6 +57,8 @@ class PairCheck:
     chi2 : float
         Of this equation group (2 dof for a pair, 3 for a turn).
     p_value : float
+    poses : (int, int) or None
+        Indices of the two still poses of a pair.
     """
 
     kind: str
@@ -67,6 +69,7 @@ class PairCheck:
     residual_deg: float
     chi2: float
     p_value: float
+    poses: tuple[int, int] | None = None
 
     @property
     def disagrees(self) -> bool:
@@ -74,7 +77,9 @@ class PairCheck:
 
     def to_dict(self) -> dict:
         return {k: getattr(self, k) for k in ("kind", "label", "t_start", "t_stop", "angle_deg", "residual_deg",
-                                              "chi2", "p_value")} | {"disagrees": self.disagrees}
+                                              "chi2", "p_value")} | {"disagrees": self.disagrees,
+                                                                     "poses": None if self.poses is None
+                                                                     else list(self.poses)}
 
 
 @dataclass(frozen=True)
@@ -155,7 +160,7 @@ def _checks(prob: GyroProblem, p, model, with_g, statics, accel: AccelFit, means
             chi2 = float(np.sum(ri**2 / vi))
             out.append(PairCheck("pair", f"pose {i + 1} -> {j + 1}", statics[i].t_stop, statics[j].t_start,
                                  float(np.degrees(ang)), float(np.degrees(np.linalg.norm(ri) * s)), chi2,
-                                 float(stats.chi2.sf(chi2, 2))))
+                                 float(stats.chi2.sf(chi2, 2)), (int(i), int(j))))
     if prob.turns:
         r = prob.turn_residuals(a, b, g).reshape(-1, 3)
         vec = prob.turn_vectors(a, b, g)

@@ -183,8 +183,8 @@ def predict_poses(poses: int = 24, turn_deg: float = 90.0, *, static_duration: f
                     total_time=float(t[-1] - t[0]), coverage=coverage(np.array([f[a] for a, _ in spans])))
 
 
-def suggest_poses(targets: dict[str, float], *, pose_counts=(9, 12, 18, 24, 36, 48), turns=(45.0, 90.0, 135.0, 180.0),
-                  **options) -> PosePlan:
+def suggest_poses(targets: dict[str, float], *, pose_counts=(12, 16, 20, 24, 30, 36, 48),
+                  turns=(45.0, 90.0, 135.0), **options) -> PosePlan:
     """The shortest plan on a grid of pose counts and turn sizes that reaches every target.
 
     Parameters
@@ -193,7 +193,8 @@ def suggest_poses(targets: dict[str, float], *, pose_counts=(9, 12, 18, 24, 36, 
         Largest acceptable 1-sigma per figure of :data:`FIGURES` (for example
         ``{"gyro_scale": 1e-3, "accel_offset": 0.01}``).
     pose_counts, turns : sequence
-        The grid searched.
+        The grid searched. It starts at 12 poses: fewer leave the 9-parameter accelerometer too few
+        spare equations to check its fit, and ``gyrocal imu`` then fits scale and bias only.
     **options
         Passed to :func:`predict_poses`.
 

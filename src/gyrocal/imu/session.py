@@ -128,9 +128,19 @@ def _ferraris_turns(t, gyro, accel_raw, windows, accel: AccelFit, statics) -> tu
     return turns, notes
 
 
+def _pairs_without_gaps(statics, gaps) -> tuple[np.ndarray, list[tuple[int, int]]]:
+    """Consecutive pose pairs whose move holds no gap, and the ones left out."""
+    gaps = np.asarray(list(gaps), dtype=int)
+    keep, lost = [], []
+    for i in range(len(statics) - 1):
+        a, b = statics[i].stop - 1, statics[i + 1].start
+        (lost if np.any((gaps > a) & (gaps <= b)) else keep).append((i, i + 1))
+    return np.array(keep, dtype=int).reshape(-1, 2), lost
+
+
 def calibrate_imu(t, gyro, accel, *, gravity: float = 9.80665, windows: Sequence[Window] | None = None,
                   accel_model="auto", gyro_model="auto", g_sensitivity: bool = False,
-                  min_static: float = 1.0) -> ImuCalibrationResult:
+                  min_static: float = 1.0, gaps: Sequence[int] = ()) -> ImuCalibrationResult:
     """Calibrate the accelerometer and the gyro of a hand session.
 
     Parameters
@@ -153,6 +163,9 @@ def calibrate_imu(t, gyro, accel, *, gravity: float = 9.80665, windows: Sequence
         Fit the gyro's sensitivity to specific force where the poses determine it.
     min_static : float
         Shortest still pose the detector keeps [s].
+    gaps : sequence of int
+        Samples before which samples are missing (:attr:`gyrocal.timebase.TimeBase.gaps`): a turn
+        across a gap has lost angle, so the pose pair around it is left out.
     """
     t = finite_array("t", t, ndim=1)
     gyro = finite_array("gyro", gyro, shape_tail=(3,), ndim=2)
@@ -179,7 +192,10 @@ def calibrate_imu(t, gyro, accel, *, gravity: float = 9.80665, windows: Sequence
     afit = fit_accelerometer(means, se, gravity=gravity, model=accel_model, directions=directions)
     force = afit.correct(accel)
     turns, notes = (_ferraris_turns(t, gyro, accel, windows, afit, statics) if ferraris else ([], []))
-    gfit = fit_gyroscope(t, gyro, force, statics, afit, turns=turns, model=gyro_model, g_sensitivity=g_sensitivity)
+    pairs, lost = _pairs_without_gaps(statics, gaps)
+    notes += [f"pose {i + 1} -> {j + 1} left out: samples are missing in the move between them" for i, j in lost]
+    gfit = fit_gyroscope(t, gyro, force, statics, afit, pairs=pairs, turns=turns, model=gyro_model,
+                         g_sensitivity=g_sensitivity)
     cov = coverage(afit.directions)
     warnings = list(afit.fit.warnings) + notes + list(gfit.fit.warnings)
     if cov.spread < _POOR_SPREAD and not ferraris:

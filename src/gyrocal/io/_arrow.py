@@ -31,8 +31,11 @@ def _plain(chunk) -> np.ndarray | None:
     return np.frombuffer(chunk.buffers()[1], dtype=dtype, count=len(chunk), offset=chunk.offset * dtype.itemsize)
 
 
-def numeric_to_numpy(column, out: np.ndarray | None = None) -> np.ndarray:
-    """A numeric column as one numpy array (copied into `out` when given); nulls become NaN."""
+def numeric_to_numpy(column, out: np.ndarray | None = None, copy: bool = True) -> np.ndarray:
+    """A numeric column as one numpy array (copied into `out` when given); nulls become NaN.
+
+    With ``copy=False`` a single null-free chunk comes back as a read-only view of pyarrow's buffer.
+    """
     parts = []
     for chunk in _chunks(column):
         view = _plain(chunk)
@@ -40,7 +43,7 @@ def numeric_to_numpy(column, out: np.ndarray | None = None) -> np.ndarray:
             view = np.asarray(pc.fill_null(pc.cast(chunk, pa.float64()), np.nan).to_pylist(), dtype=float)
         parts.append(view)
     if out is None:
-        return np.concatenate(parts) if len(parts) != 1 else parts[0].copy()
+        return np.concatenate(parts) if len(parts) != 1 else (parts[0].copy() if copy else parts[0])
     pos = 0
     for part in parts:
         out[pos:pos + len(part)] = part
@@ -80,10 +83,15 @@ def from_numpy(a: np.ndarray):
         data = np.ascontiguousarray(a, dtype=a.dtype.newbyteorder("="))
         return pa.Array.from_buffers(pa.from_numpy_dtype(data.dtype), len(data), [None, pa.py_buffer(data)])
     text = np.asarray([("" if v is None else str(v)) for v in a.tolist()] if a.dtype.kind == "O" else a, dtype=str)
-    raw = np.char.encode(text, "utf-8").astype(f"S{max(text.dtype.itemsize // 4, 1) * 4}")
-    lengths = np.char.str_len(raw)
-    offsets = np.zeros(len(raw) + 1, dtype=np.int64)
+    codes = text.view(np.uint32).reshape(len(text), max(text.dtype.itemsize // 4, 1))
+    if codes.size and codes.max() < 128:  # ASCII (axis labels, most logs): each character is its code's byte
+        filled = codes != 0  # numpy pads its fixed-width strings with NUL at the end
+        lengths, data = filled.sum(axis=1), codes[filled].astype(np.uint8)
+    else:
+        raw = np.char.encode(text, "utf-8").astype(f"S{max(text.dtype.itemsize // 4, 1) * 4}")
+        lengths = np.char.str_len(raw)
+        body = raw.view(np.uint8).reshape(len(raw), raw.dtype.itemsize)
+        data = np.ascontiguousarray(body[np.arange(raw.dtype.itemsize) < lengths[:, None]])
+    offsets = np.zeros(len(text) + 1, dtype=np.int64)
     np.cumsum(lengths, out=offsets[1:])
-    body = raw.view(np.uint8).reshape(len(raw), raw.dtype.itemsize)
-    data = np.ascontiguousarray(body[np.arange(raw.dtype.itemsize) < lengths[:, None]])
-    return pa.Array.from_buffers(pa.large_string(), len(raw), [None, pa.py_buffer(offsets), pa.py_buffer(data)])
+    return pa.Array.from_buffers(pa.large_string(), len(text), [None, pa.py_buffer(offsets), pa.py_buffer(data)])

@@ -160,6 +160,8 @@ def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool
 
 
 def _read_arrow(path: Path, packed: str | None, layout: Layout, mapping: dict, encoding: str) -> dict:
+    """Columns of a text table through pyarrow's streaming reader: each block of rows becomes numpy pieces
+    as it is parsed, so memory holds the numbers (twice while they are joined), not pyarrow's whole table."""
     import pyarrow as pa
     import pyarrow.csv as pcsv
 
@@ -167,24 +169,36 @@ def _read_arrow(path: Path, packed: str | None, layout: Layout, mapping: dict, e
 
     names = layout.names
     numeric = [mapping[c] for c in NUMERIC if c in mapping]
+    axis = mapping.get("axis")
 
-    def read(as_float: bool, encoding: str = "utf8"):
+    def read(as_float: bool, encoding: str = "utf8") -> dict[str, list]:
         types = {n: (pa.float64() if as_float and n in numeric else pa.string()) for n in names}
+        pieces: dict[str, list] = {n: [] for n in names}
         with arrow_input(path, packed) as source:
-            return pcsv.read_csv(
+            reader = pcsv.open_csv(
                 source,
                 # our stripped names replace the header row
-                read_options=pcsv.ReadOptions(skip_rows=layout.data, column_names=names, encoding=encoding),
+                read_options=pcsv.ReadOptions(skip_rows=layout.data, column_names=names, encoding=encoding,
+                                              block_size=1 << 24),
                 parse_options=pcsv.ParseOptions(delimiter=layout.delimiter, ignore_empty_lines=True),
                 convert_options=pcsv.ConvertOptions(column_types=types, strings_can_be_null=False,
                                                     decimal_point="," if layout.decimal_comma else "."),
             )
+            for batch in reader:
+                for n, column in zip(names, batch.columns):
+                    pieces[n].append(_piece(column, n))
+        return pieces
+
+    def _piece(column, name: str):
+        if pa.types.is_floating(column.type):
+            return numeric_to_numpy(column, copy=False)
+        return text_to_numpy(column, dtype=str if name == axis else object)
 
     # pyarrow reads UTF-8 (its BOM included) natively and transcodes anything else
     as_float, encoding = True, "utf8" if encoding == "utf-8-sig" else encoding
     for _ in range(3):
         try:
-            table = read(as_float, encoding)
+            pieces = read(as_float, encoding)
             break
         except pa.ArrowInvalid as exc:
             message = str(exc)
@@ -196,19 +210,27 @@ def _read_arrow(path: Path, packed: str | None, layout: Layout, mapping: dict, e
                 raise InputError(f"{path.name}: cannot parse the table ({message.splitlines()[0]})") from None
     else:
         raise InputError(f"{path.name}: cannot parse the table")
-    rates = [mapping[c] for c in ("gx", "gy", "gz")]
+    cols = _joined(pieces, [mapping[c] for c in ("gx", "gy", "gz")], axis)
+    pa.default_memory_pool().release_unused()  # pyarrow's allocator keeps freed blocks; the rest of the run needs them
+    return cols
+
+
+def _joined(pieces: dict[str, list], rates: list[str], axis: str | None) -> dict[str, np.ndarray]:
+    """One array per column from its pieces; the rates share one (3, N) block, whose transpose is the
+    recording's column-major (N, 3) array without another copy (see _build._rates_block)."""
+    n = sum(len(p) for p in next(iter(pieces.values())))
+    block = np.empty((3, n)) if all(p.dtype == np.float64 for r in rates for p in pieces[r]) else None
     cols = {}
-    if all(pa.types.is_float64(table.column(n).type) for n in rates):
-        # fill one (3, N) block: the recording is built on its transpose, a column-major (N, 3)
-        # array, without another copy (see _build._rates_block)
-        block = np.empty((3, table.num_rows))
-        for j, name in enumerate(rates):
-            cols[name] = numeric_to_numpy(table.column(name), out=block[j])
-    for n in names:
-        column = table.column(n)
-        if n not in cols:
-            cols[n] = (numeric_to_numpy(column) if pa.types.is_floating(column.type)
-                       else text_to_numpy(column, dtype=str if n == mapping.get("axis") else object))
+    for name in list(pieces):
+        parts = pieces.pop(name)  # each column's pieces go as soon as it is joined
+        if block is not None and name in rates:
+            cols[name] = block[rates.index(name)]
+            if parts:
+                np.concatenate(parts, out=cols[name])
+        elif parts:
+            cols[name] = np.concatenate(parts)
+        else:
+            cols[name] = np.empty(0, dtype=object if name != axis else str)
     return cols
 
 

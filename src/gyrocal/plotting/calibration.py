@@ -16,7 +16,7 @@ from ..calibration import Calibration
 from ..recording import Recording
 from ..units import RATE_UNITS, from_rad_s
 from ..windows import Window
-from .figure import new_figure
+from .figure import new_figure, outside_legend
 
 __all__ = ["calibration_figure", "display_rates", "plot_corrected", "plot_windows"]
 
@@ -62,9 +62,14 @@ def _label(w: Window) -> str:
     return f"{sense}{w.axis or '?'}"
 
 
+def _time(rec: Recording) -> np.ndarray:
+    """Time since the first sample [s]: epoch stamps (1.7e9 s) would put '+1.7e9' under the axis."""
+    return np.asarray(rec.t) - float(rec.t[0])
+
+
 def _shade(ax, rec: Recording, windows: Sequence[Window], *, text: Sequence[str] | None = None) -> tuple[list, list]:
     """One shaded span per window with a label at the top; returns (spans, texts)."""
-    t = rec.t
+    t = _time(rec)
     spans, texts = [], []
     trans = ax.get_xaxis_transform()
     for i, w in enumerate(windows):
@@ -79,7 +84,23 @@ def _shade(ax, rec: Recording, windows: Sequence[Window], *, text: Sequence[str]
     return spans, texts
 
 
-def plot_windows(ax, rec: Recording, windows: Sequence[Window], *, units: str | None = None) -> dict[str, list]:
+def _mark_ignored(ax, rec: Recording, ignored) -> tuple[list, list]:
+    """Each turn left out as a hatched span, with the reason (up to its first colon) along its foot."""
+    t = _time(rec)
+    spans, texts = [], []
+    trans = ax.get_xaxis_transform()
+    for w, why in ignored:
+        if w.kind != "rotation":
+            continue
+        t0, t1 = t[w.start], t[min(w.stop, len(t)) - 1]
+        spans.append(ax.axvspan(t0, t1, facecolor="none", edgecolor="0.55", hatch="///", lw=0))
+        texts.append(ax.text((t0 + t1) / 2, 0.02, f"ignored: {why.split(':')[0]}", transform=trans, ha="center",
+                             va="bottom", fontsize=7, color="0.3", rotation=90))
+    return spans, texts
+
+
+def plot_windows(ax, rec: Recording, windows: Sequence[Window], *, units: str | None = None,
+                 ignored=()) -> dict[str, list]:
     """Draw the raw readings with each window shaded and labelled.
 
     Parameters
@@ -91,20 +112,24 @@ def plot_windows(ax, rec: Recording, windows: Sequence[Window], *, units: str | 
         static windows are grey.
     units : {"rad/s", "deg/s"}, optional
         Display unit (default: the data's own).
+    ignored : sequence of (Window, str), optional
+        Turns left out and why (``Segmentation.ignored``): hatched and labelled with the reason.
 
     Returns
     -------
     dict
-        ``lines`` (three Line2D), ``spans`` and ``labels`` (one per window).
+        ``lines`` (three Line2D), ``spans`` and ``labels`` (one per window), ``ignored`` and
+        ``reasons`` (one per turn left out).
     """
     rates, unit = display_rates(rec, units)
-    tt, yy = _envelope(rec.t, rates)
+    tt, yy = _envelope(_time(rec), rates)
     lines = [ax.plot(tt, yy[:, i], color=AXIS_COLORS[i], lw=0.7, label=f"g{'xyz'[i]}")[0] for i in range(3)]
     spans, texts = _shade(ax, rec, windows)
+    hatched, reasons = _mark_ignored(ax, rec, ignored)
     ax.set_ylabel(f"raw [{unit}]")
-    ax.legend(loc="lower right", fontsize=8, ncol=3, framealpha=0.8)
+    outside_legend(ax)
     ax.grid(True, lw=0.3, alpha=0.5)
-    return {"lines": lines, "spans": spans, "labels": texts}
+    return {"lines": lines, "spans": spans, "labels": texts, "ignored": hatched, "reasons": reasons}
 
 
 def _turn_summary(corrected: np.ndarray, rec: Recording, w: Window, speed: float | None, unit: str) -> str:
@@ -144,7 +169,7 @@ def plot_corrected(ax, rec: Recording, cal: Calibration, windows: Sequence[Windo
     """
     w_out = from_rad_s(cal.model.correct(rec.gyro), cal.output_units)
     unit = cal.output_units
-    tt, yy = _envelope(rec.t, w_out)
+    tt, yy = _envelope(_time(rec), w_out)
     lines = [ax.plot(tt, yy[:, i], color=AXIS_COLORS[i], lw=0.7)[0] for i in range(3)]
     text = [_turn_summary(w_out, rec, w, speed, unit) if w.kind == "rotation"
             else f"{np.linalg.norm(w_out[w.start:w.stop].mean(axis=0)):.2g}" for w in windows]
@@ -162,7 +187,7 @@ def plot_corrected(ax, rec: Recording, cal: Calibration, windows: Sequence[Windo
 
 
 def calibration_figure(rec: Recording, windows: Sequence[Window], cal: Calibration | None = None, *,
-                       fig=None, speed: float | None = None, title: str | None = None):
+                       fig=None, speed: float | None = None, title: str | None = None, ignored=()):
     """Raw readings with windows on top, corrected readings below (when `cal` is given).
 
     Parameters
@@ -177,6 +202,8 @@ def calibration_figure(rec: Recording, windows: Sequence[Window], cal: Calibrati
     speed : float, optional
         Known turn rate [rad/s].
     title : str, optional
+    ignored : sequence of (Window, str), optional
+        Turns left out and why, marked on the raw panel (``gyrocal segments --plot``).
 
     Returns
     -------
@@ -186,12 +213,12 @@ def calibration_figure(rec: Recording, windows: Sequence[Window], cal: Calibrati
     if fig is None:
         fig = new_figure((11.0, 3.6 * rows + 0.6), layout="constrained")
     axes = fig.subplots(rows, 1, sharex=True, squeeze=False)[:, 0]
-    plot_windows(axes[0], rec, windows)
+    plot_windows(axes[0], rec, windows, ignored=ignored)
     n_rot = sum(w.kind == "rotation" for w in windows)
     axes[0].set_title(f"raw with windows: {n_rot} rotation, {len(windows) - n_rot} static", fontsize=9, loc="left")
     if cal is not None:
         plot_corrected(axes[1], rec, cal, windows, speed=speed)
-    axes[-1].set_xlabel("time [s]")
+    axes[-1].set_xlabel("time since the first sample [s]")
     if title:
         fig.suptitle(title, fontsize=10)
     return fig

@@ -8,7 +8,7 @@ from pathlib import Path
 from .._atomic import atomic_path
 from ..errors import InputError, MissingDependencyError
 
-__all__ = ["check_figure_path", "new_figure", "save_figure"]
+__all__ = ["check_figure_path", "new_figure", "outside_legend", "plain_ticks", "save_figure"]
 
 _HINT = "plots need matplotlib: pip install 'gyrocal[plot]'"
 _FORMATS = ("png", "pdf", "svg")
@@ -50,8 +50,32 @@ def check_figure_path(path: str | os.PathLike) -> str:
     return fmt
 
 
+def outside_legend(ax, **kwargs):
+    """A legend beside the axes, right of them, where it cannot cover data."""
+    kwargs.setdefault("fontsize", 8)
+    return ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, **kwargs)
+
+
+def plain_ticks(fig) -> None:
+    """Tick labels written out in full: no offset or multiplier text ('+1.7e9', '1e-5') above an axis,
+    where it would collide with a left-aligned title."""
+    from matplotlib.ticker import ScalarFormatter
+
+    for ax in fig.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            fmt = axis.get_major_formatter()
+            if isinstance(fmt, ScalarFormatter):
+                fmt.set_useOffset(False)
+                fmt.set_scientific(False)
+
+
 def save_figure(fig, path: str | os.PathLike, dpi: int = 110) -> None:
-    """Write `fig` to `path` atomically; the format follows the suffix (png, pdf or svg)."""
+    """Write `fig` to `path` atomically; the format follows the suffix (png, pdf or svg).
+
+    Tick labels are written out (:func:`plain_ticks`) and the saved area includes legends
+    placed beside the axes (:func:`outside_legend`).
+    """
     fmt = check_figure_path(path)
+    plain_ticks(fig)
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format=fmt, dpi=dpi)
+        fig.savefig(tmp, format=fmt, dpi=dpi, bbox_inches="tight")

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from .figure import new_figure
+from .figure import new_figure, outside_legend
 
 __all__ = ["allan_deviation_plot", "allan_figure"]
 
@@ -58,8 +58,8 @@ def allan_deviation_plot(ax, sensor, *, axes: str = "xyz", unit: str | None = No
     ax.grid(True, which="both", alpha=0.3)
     shown = sensor.adev[:3] * factor
     ax.set_ylim(np.nanmin(shown) / 3, np.nanmax(shown) * 3)
-    ax.legend(title="dotted: density (-1/2), dashed: random walk (+1/2), dot: flat minimum", fontsize=7,
-              title_fontsize=7, loc="upper right")
+    outside_legend(ax, title="dotted: density (-1/2)\ndashed: random walk (+1/2)\ndot: flat minimum", fontsize=7,
+                   title_fontsize=7)
     return art
 
 

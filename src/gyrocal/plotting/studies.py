@@ -10,7 +10,7 @@ from typing import Mapping
 
 import numpy as np
 
-from .figure import new_figure
+from .figure import new_figure, outside_legend
 
 __all__ = ["error_boxes", "error_box_figure", "mse_vs_speed", "mse_speed_figure", "convergence", "convergence_figure",
            "rms_by_temperature", "rms_by_temperature_figure"]
@@ -70,7 +70,7 @@ def error_box_figure(errors: Mapping[tuple[float, str], np.ndarray], crb: Mappin
                         title=f"{_LABELS.get(method, method)}, noise {noise:g} rad/s")
         axes[i, 0].set_ylabel("estimate - truth")
     if crb is not None:
-        axes[0, -1].legend(fontsize=7, loc="upper right")
+        outside_legend(axes[0, -1], fontsize=7)
     fig.suptitle(title, fontsize=10)
     return fig
 
@@ -109,7 +109,7 @@ def mse_speed_figure(speeds, mse: Mapping[tuple[float, str], np.ndarray], crb: M
         for j, noise in enumerate(noises):
             mse_vs_speed(axes[i, j], speeds, mse[noise, method], None if crb is None else crb.get(noise),
                          title=f"{_LABELS.get(method, method)}, noise {noise:g} rad/s")
-    axes[0, -1].legend(fontsize=7, ncol=2, title="dashed: CRB" if crb is not None else None, title_fontsize=7)
+    outside_legend(axes[0, -1], fontsize=7, ncol=2, title="dashed: CRB" if crb is not None else None, title_fontsize=7)
     fig.suptitle(title, fontsize=10)
     return fig
 
@@ -139,7 +139,7 @@ def convergence_figure(cases: Mapping[str, tuple[np.ndarray, np.ndarray]], *, ti
     axes = fig.subplots(1, len(cases), squeeze=False)[0]
     for ax, (name, (history, truth)) in zip(axes, cases.items()):
         convergence(ax, history, truth, title=name)
-    axes[-1].legend(fontsize=7, ncol=2)
+    outside_legend(axes[-1], fontsize=7, ncol=2)
     fig.suptitle(title, fontsize=10)
     return fig
 
@@ -166,7 +166,7 @@ def rms_by_temperature(ax, temps, rms: Mapping[str, "np.ndarray"], *, floor: flo
         lines.append(ax.axhline(floor, linestyle="--", color="k", linewidth=1.0, zorder=3,
                                 label=f"noise floor of a step mean, \u03c3/\u221an = {floor:.3g} deg/s"))
     _label(ax, "test temperature [degC]", "RMS step error [deg/s]", title)
-    ax.legend(fontsize=7)
+    outside_legend(ax, fontsize=7)
     return lines
 
 

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..models import KG_NAMES
 from ..units import unit_factor
-from .figure import new_figure
+from .figure import new_figure, outside_legend
 
 __all__ = ["METHOD_STYLE", "plot_coefficients", "plot_error_vs_rate", "plot_error_vs_temperature"]
 
@@ -72,7 +72,7 @@ def plot_coefficients(cal, fig=None, *, units: str | None = None, truth=None) ->
         ax.ticklabel_format(axis="y", useOffset=False, style="sci", scilimits=(-3, 4))
     for ax in axes[-3:]:
         ax.set_xlabel("temperature [degC]", fontsize=8)
-    axes[0].legend(fontsize=7)
+    outside_legend(axes[0], fontsize=7)
     fig.suptitle("Kg elements against temperature (the full-temperature-range method, eq. 14)")
     return out
 
@@ -106,7 +106,7 @@ def plot_error_vs_rate(evaluation, fig=None, *, units: str = "deg/s", methods=No
                 ax.set_xlabel(f"table rate [{units}]", fontsize=8)
             if j == 0:
                 ax.set_ylabel(f"error [{units}]", fontsize=8)
-    axes[0, 0].legend(fontsize=7)
+    outside_legend(axes[0, 0], fontsize=7)
     return {"figure": fig, "axes": axes, "series": series}
 
 
@@ -134,5 +134,5 @@ def plot_error_vs_temperature(evaluation, ax=None, *, units: str = "deg/s", meth
     ax.set_xlabel("temperature [degC]")
     ax.set_ylabel(f"RMS error [{units}]")
     ax.set_title("RMS step error against temperature")
-    ax.legend(fontsize=8)
+    outside_legend(ax, fontsize=8)
     return {"figure": ax.figure, "ax": ax, "lines": lines}

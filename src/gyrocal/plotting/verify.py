@@ -13,11 +13,12 @@ import numpy as np
 
 from ..errors import InputError
 from .calibration import AXIS_COLORS
-from .figure import new_figure
+from .figure import new_figure, outside_legend
 
 __all__ = ["default_stretch", "error_figure", "overlay_figure", "plot_errors", "plot_overlay"]
 
 _MAX_POINTS = 40_000  # per line; longer stretches are drawn every k-th sample
+MEAN_S = 1.0  # running mean of the error figure [s]: noise averages out, bias and scale errors stay
 _AXES = ("x", "y", "z")
 
 
@@ -65,23 +66,38 @@ def plot_overlay(ax, t, test, reference, axis: int, *, units: str, label: str = 
     gyro, = ax.plot(t[w], test[w, axis], color=AXIS_COLORS[axis], lw=0.8, label=f"{label} {_AXES[axis]}")
     ref, = ax.plot(t[w], reference[w, axis], color="black", lw=0.8, ls="--", label=f"reference {_AXES[axis]}")
     ax.set_ylabel(f"{_AXES[axis]} [{units}]")
-    ax.legend(loc="upper right", fontsize=8)
+    outside_legend(ax)
     return [gyro, ref]
 
 
-def plot_errors(ax, t, before, after, axis: int, *, units: str, stretch=None) -> list:
-    """Error against the reference before (grey) and after (axis colour) calibration; returns the lines.
+def _running_mean(t: np.ndarray, y: np.ndarray, seconds: float) -> np.ndarray:
+    """Centred running mean of `y` over about `seconds` [s] (edges shortened)."""
+    n = max(1, int(round(seconds / max(float(np.median(np.diff(t))), np.finfo(float).tiny))))
+    c = np.concatenate([[0.0], np.cumsum(y)])
+    lo = np.clip(np.arange(len(y)) - n // 2, 0, len(y))
+    hi = np.clip(np.arange(len(y)) + n - n // 2, 0, len(y))
+    return (c[hi] - c[lo]) / (hi - lo)
+
+
+def plot_errors(ax, t, before, after, axis: int, *, units: str, stretch=None, smooth_s: float = MEAN_S) -> list:
+    """Error against the reference before (grey) and after (axis colour) calibration, each with its
+    running mean over `smooth_s` seconds drawn bold (the systematic part: bias, scale); returns the lines.
 
     `before` may be None (raw counts without a sensitivity): only the error after is drawn.
     """
     w = _window(t, stretch)
-    lines = []
-    if before is not None:
-        lines += ax.plot(t[w], before[w, axis], color="0.6", lw=0.7, label="before calibration")
-    lines += ax.plot(t[w], after[w, axis], color=AXIS_COLORS[axis], lw=0.7, label="after calibration")
+    drawn = [(err, label, style) for err, label, style in (
+        (before, "before calibration", {"color": "0.6", "mean": {"color": "0.15", "ls": "--"}}),
+        (after, "after calibration", {"color": AXIS_COLORS[axis], "mean": {"color": "black", "ls": "-"}}))
+        if err is not None]
+    lines = [ax.plot(t[w], err[w, axis], color=style["color"], lw=0.5, alpha=0.6, label=label)[0]
+             for err, label, style in drawn]
+    # the means go on top of both noisy traces, so the systematic error before calibration stays visible
+    lines += [ax.plot(t[w], _running_mean(t, err[:, axis], smooth_s)[w], lw=1.6, zorder=3,
+                      label=f"{label}, {smooth_s:g} s mean", **style["mean"])[0] for err, label, style in drawn]
     ax.axhline(0.0, color="black", lw=0.5)
     ax.set_ylabel(f"error {_AXES[axis]} [{units}]")
-    ax.legend(loc="upper right", fontsize=8)
+    outside_legend(ax, fontsize=7)
     return lines
 
 

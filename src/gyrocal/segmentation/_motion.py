@@ -14,7 +14,7 @@ import numpy as np
 __all__ = ["Motion", "detect_motion", "runs_of", "static_level"]
 
 _MAX_STATS = 1_000_000  # samples enough for a quantile; more only costs time
-_MAX_CLUSTER = 2000  # quiet blocks compared pairwise
+_MAX_CLUSTER = 800  # quiet blocks compared pairwise (spread over the session; their median is the level)
 _MAX_BLOCK_SAMPLES = 250_000  # spread evenly over the session for the static level
 
 
@@ -113,17 +113,24 @@ def _split_turnarounds(runs, level, labels, csum, high, min_len) -> np.ndarray:
     return np.stack([np.sort(np.concatenate((runs[:, 0], pts))), np.sort(np.concatenate((runs[:, 1], pts)))], axis=1)
 
 
-def _neighbours(points: np.ndarray, radius: float):
+def _neighbours(points: np.ndarray, radius: float, chunk: int = 256):
     """How many of `points` (q, 3) lie within `radius` of each, and a look-up of one's neighbours.
 
-    A k-d tree keeps memory linear in q; a pairwise distance matrix was most of the peak
-    memory of a long recording.
+    Distances are taken `chunk` rows at a time, so memory stays at ``chunk x q`` whatever q is: a
+    whole ``q x q`` matrix was most of the peak memory of a long recording.
     """
-    from scipy.spatial import cKDTree
+    r2 = radius * radius
 
-    tree = cKDTree(points)
-    count = tree.query_ball_point(points, radius, return_length=True, p=2.0)
-    return np.asarray(count), lambda i: np.asarray(tree.query_ball_point(points[i], radius), dtype=np.intp)
+    def near(rows: slice) -> np.ndarray:
+        # squared distances axis by axis: a (chunk, 3) @ (3, q) product is slow in BLAS for so few columns
+        d2 = np.zeros((len(points[rows]), len(points)))
+        for k in range(points.shape[1]):
+            diff = np.subtract.outer(points[rows, k], points[:, k])
+            d2 += diff * diff
+        return d2 < r2
+
+    count = np.concatenate([near(slice(i, i + chunk)).sum(axis=1) for i in range(0, len(points), chunk)])
+    return count, lambda i: np.flatnonzero(near(slice(i, i + 1))[0])
 
 
 def static_level(gyro: np.ndarray, block: int) -> tuple[np.ndarray, np.ndarray, float]:

@@ -11,6 +11,7 @@ import numpy as np
 
 from ..errors import SegmentationError
 from ..windows import Window
+from ._advice import measured_turns
 
 __all__ = ["Segmentation", "describe_found"]
 
@@ -57,6 +58,10 @@ class Segmentation:
         Reading at standstill [reading units].
     noise_std : ndarray, shape (3,)
         Per-sample noise on the quietest stretches [reading units].
+    units : {"rad/s", "counts"}
+        Internal units of the readings (to show the turns measured).
+    advice : str
+        The most likely fix when the turns a method needs are missing (see :meth:`require`).
     """
 
     windows: tuple[Window, ...]
@@ -65,6 +70,8 @@ class Segmentation:
     sample_rate: float = 1.0
     baseline: np.ndarray = field(default_factory=lambda: np.zeros(3))
     noise_std: np.ndarray = field(default_factory=lambda: np.full(3, np.nan))
+    units: str = "rad/s"
+    advice: str = ""
 
     def __post_init__(self):
         object.__setattr__(self, "windows", tuple(sorted(self.windows, key=lambda w: w.start)))
@@ -98,13 +105,15 @@ class Segmentation:
         if len(rot) < min_rotations:
             need.append(f"{len(rot)} rotation(s) where the method needs {min_rotations}")
         short = any(why.startswith(NO_PLATEAU) for _, why in self.ignored)
+        turns = measured_turns(self.ignored, self.units)
+        advice = ("turns too short to hold a steady speed: calibrate with the angle reference ({param:angle} 360)"
+                  if short else self.advice
+                  or "check {param:speed}/{param:angle} and {param:units}, or give the windows with {param:windows}")
         raise SegmentationError(
-            f"found {describe_found(self.windows, self.ignored)}: {'; '.join(need)}. The method needs a "
-            "rotation about every axis, in both senses" + (" or with a static window" if static_allowed else "")
-            + ("; turns too short to hold a steady speed: calibrate with the angle reference (--angle 360)"
-               if short else "")
-            + "; check --speed/--angle and the units, or give the windows with --windows"
-        )
+            f"found {describe_found(self.windows, self.ignored)}: {'; '.join(need)}"
+            + (f"; the turns left out measure {turns}" if turns else ""),
+            hint="the method needs a rotation about every axis, in both senses"
+                 + (" or with a static window" if static_allowed else "") + f"; most likely: {advice}")
 
     def summary(self, rate_unit: str = "deg/s") -> str:
         """Plain-text table of the windows chosen and ignored (rates in `rate_unit`)."""

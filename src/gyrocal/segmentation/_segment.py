@@ -24,6 +24,7 @@ from .._validation import positive
 from ..errors import InputError, SegmentationError
 from ..recording import Recording
 from ..windows import Window
+from ._advice import advise
 from ._motion import detect_motion, runs_of
 from ._plateaus import speed_turns
 from ._result import Segmentation
@@ -155,8 +156,11 @@ def segment(
     busy = np.concatenate([mo.busy, np.asarray(spans, dtype=np.int64).reshape(-1, 2)])
     sta, ign_sta = _statics(n, view.sample_rate, busy, static_trim, min_static, mo.smooth)
     up = functools.partial(_upsample, d=d, n=n, total=len(rec), fs=fs, reference=reference)
-    seg = Segmentation(tuple(up(w) for w in rot + sta), tuple((up(w), r) for w, r in ign + ign_sta), reference, fs,
-                       mo.baseline, mo.noise_std * math.sqrt(d))
+    ignored = tuple((up(w), r) for w, r in ign + ign_sta)
+    seg = Segmentation(tuple(up(w) for w in rot + sta), ignored, reference, fs, mo.baseline,
+                       mo.noise_std * math.sqrt(d), rec.units,
+                       advise(ignored, reference, speed if reference == "speed" else angle, rec.units,
+                              accepted=len(rot), sample_rate=fs, has_time=rec.has_time))
     if require:
         seg.require()
     return seg

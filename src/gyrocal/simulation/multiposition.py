@@ -26,7 +26,8 @@ from ..imu import quaternion as quat
 from ..imu.gyro import EARTH_RATE
 from .gyro import VirtualGyro
 
-__all__ = ["ImuSession", "MultiPositionProtocol", "VirtualImu", "simulate_multi_position"]
+__all__ = ["ImuSession", "MultiPositionProtocol", "VirtualImu", "hand_session", "mounted_gyro", "random_accelerometer",
+           "session_facts", "session_recording", "simulate_multi_position"]
 
 
 @dataclass(frozen=True)
@@ -260,3 +261,72 @@ def simulate_multi_position(imu: VirtualImu, protocol: MultiPositionProtocol | N
              "gyro_matrix": np.linalg.inv(aff.K), "gyro_offset": np.array(aff.B),
              "g_sensitivity": imu.g_sensitivity.copy(), "gravity": p.gravity}
     return ImuSession(t=t, gyro=gyro, accel=accel, still=still, orientations=q_poses, truth=truth)
+
+
+def random_accelerometer(rng: np.random.Generator, *, scale_error: float = 0.02, cross_deg: float = 0.5,
+                         offset: float = 0.1) -> tuple[np.ndarray, np.ndarray]:
+    """A plausible MEMS accelerometer truth in the 9-parameter model's frame: ``(A, o)``.
+
+    Scale factors within ``1 +- scale_error``, non-orthogonality of about `cross_deg` [deg],
+    offsets of about `offset` [m/s^2] (lower-triangular ``A``: x along the sensor's x axis).
+    """
+    a = np.eye(3) * (1 + rng.uniform(-scale_error, scale_error, 3))
+    a[np.tril_indices(3, -1)] = rng.normal(0.0, np.radians(cross_deg), 3)
+    return a, rng.normal(0.0, offset, 3)
+
+
+def mounted_gyro(model, misalignment_deg: float, rng: np.random.Generator):
+    """`model` (scale and bias) with its axes turned by `misalignment_deg` [deg] about a random axis
+    from the accelerometer's frame, as an :class:`~gyrocal.models.Affine` (readings ``K w + B``)."""
+    from ..models import Affine
+
+    aff = model.to_affine()
+    axis = rng.normal(size=3)
+    turn = quat.to_matrix(quat.from_rotvec(np.radians(misalignment_deg) * axis / np.linalg.norm(axis)))
+    return Affine(K=aff.K @ turn.T, B=aff.B)
+
+
+def session_recording(session: ImuSession, units: str = "rad/s"):
+    """The simulated session as a :class:`~gyrocal.recording.Recording` (gyro rad/s, accelerometer m/s^2)."""
+    from ..recording import Recording
+
+    return Recording(t=session.t, gyro=session.gyro, accel=session.accel, accel_units="m/s^2",
+                     accel_source_units="m/s^2", source_units=units)
+
+
+def session_facts(session: ImuSession) -> dict:
+    """The truth of a session beyond the gyro model, as JSON for the truth file."""
+    tr = session.truth
+    return {"accelerometer": {"matrix": tr["accel_matrix"].tolist(), "offset": tr["accel_offset"].tolist(),
+                              "units": "m/s^2", "equation": "a_true = matrix @ (raw - offset)"},
+            "gyro_correction": {"matrix": tr["gyro_matrix"].tolist(), "offset": tr["gyro_offset"].tolist(),
+                                "units": "rad/s", "equation": "w_true = matrix @ (raw - offset - G a_true)"},
+            "g_sensitivity": tr["g_sensitivity"].tolist(), "gravity": tr["gravity"],
+            "poses": session.orientations.tolist(), "still": session.still.tolist()}
+
+
+def hand_session(gyro_model, *, gyro_kw: dict, poses: int = 24, tilt_deg: float = 90.0, still: float = 3.0,
+                 accel_noise_std: float = 0.02, misalignment_deg: float = 5.0, sample_rate: float = 100.0,
+                 rng: np.random.Generator):
+    """The whole-IMU session of ``gyrocal simulate --protocol multi-position``.
+
+    The gyro (`gyro_model` and :class:`VirtualGyro` options `gyro_kw`) is mounted `misalignment_deg`
+    off a drawn accelerometer (:func:`random_accelerometer`); `poses` poses a tilt of `tilt_deg`
+    apart, each still for ``still`` s +- 25 %.
+
+    Returns
+    -------
+    (Recording, Affine, dict, dict)
+        The recording, the gyro's true model, the truth facts, the settings.
+    """
+    from .gyro import VirtualGyro
+
+    gyro = mounted_gyro(gyro_model, misalignment_deg, rng)
+    a, o = random_accelerometer(rng)
+    imu = VirtualImu(VirtualGyro(gyro, **gyro_kw), accel_matrix=a, accel_offset=o, accel_noise_std=accel_noise_std)
+    proto = MultiPositionProtocol(poses=poses, turn_deg=tilt_deg, static_duration=(0.75 * still, 1.25 * still),
+                                  sample_rate=sample_rate)
+    session = simulate_multi_position(imu, proto, rng=rng)
+    settings = {"poses": poses, "tilt_deg": tilt_deg, "still_s": still, "accel_noise_std": accel_noise_std,
+                "misalignment_deg": misalignment_deg}
+    return session_recording(session), gyro, session_facts(session), settings

@@ -20,7 +20,8 @@ from .._validation import positive
 from ..errors import InputError
 from ..recording import Recording
 
-__all__ = ["ReceiveClock", "drop_samples", "receive_times", "with_time_defects"]
+__all__ = ["ReceiveClock", "drop_samples", "receive_times", "rows_after_gaps", "simulate_time_defects",
+           "with_time_defects"]
 
 
 @dataclass(frozen=True)
@@ -148,3 +149,41 @@ def with_time_defects(
         extra={k: np.asarray(v)[keep] for k, v in rec.extra.items()}, sensitivity=rec.sensitivity,
     )
     return out, truth
+
+
+def rows_after_gaps(index, gaps) -> np.ndarray:
+    """Rows of the recording with gaps that original sample numbers `index` became.
+
+    `gaps` is the truth's ``[[first missing original sample, count], ...]``; a sample inside a
+    gap maps to the first row after it.
+    """
+    idx = np.asarray(index, dtype=np.int64)
+    shift = np.zeros_like(idx)
+    for start, count in gaps:
+        shift += np.clip(idx - start, 0, count)
+    return idx - shift
+
+
+def simulate_time_defects(rec: Recording, facts: dict, rng: np.random.Generator, *, stamps: str = "sensor",
+                          late_per_minute: float = 0.0, gaps: int = 0, gap_length: float = 0.17):
+    """`rec` with receive-time stamps and packet gaps, its truth `facts` moved to the recording's rows.
+
+    Returns the recording, the facts (``windows`` and ``plateaus`` as rows of the new recording, and
+    ``time_base``: the receive clock and the gaps as ``[first missing sample, count]`` of the sensor
+    clock) and the settings to record (``gyrocal simulate``'s truth sidecar).
+    """
+    if stamps not in ("sensor", "receive"):
+        raise InputError(f"stamps must be 'sensor' or 'receive', got {stamps!r}", param="stamps", value=stamps)
+    if gaps < 0 or not gap_length > 0:
+        raise InputError(f"gaps must be >= 0 and gap_length > 0 s, got {gaps} and {gap_length:g}", param="gaps")
+    clock = ReceiveClock(late_per_minute=late_per_minute) if stamps == "receive" else None
+    out, truth = with_time_defects(rec, rng, clock=clock, gaps=gaps, gap_length=gap_length)
+    moved = dict(facts)
+    for key in ("windows", "plateaus"):
+        if key in moved:
+            moved[key] = [{**w, "start": int(rows_after_gaps(w["start"], truth["gaps"])),
+                           "stop": int(rows_after_gaps(w["stop"], truth["gaps"]))} for w in moved[key]]
+    moved["time_base"] = {**truth, "note": "gaps: [first missing sample of the sensor clock, count]; windows and "
+                                           "plateaus are rows of the recording"}
+    settings = {"stamps": stamps, "late_per_minute": late_per_minute, "gaps": gaps, "gap_length_s": gap_length}
+    return out, moved, settings

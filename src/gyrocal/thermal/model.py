@@ -58,6 +58,18 @@ RULE = ("3-node Lagrange (the full-temperature-range method, eq. 21-22): i = fir
         "with s = clip(i-2, 0, n-3)")
 
 
+def _solve3(K: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """``K^-1 y`` for stacks of 3 x 3 matrices (N, 3, 3) and vectors (N, 3), by Cramer's rule.
+
+    Elementwise numpy is several times faster than a LAPACK call per tiny matrix; the tables are
+    near the identity (condition numbers close to 1), where Cramer's rule is as accurate.
+    """
+    k0, k1, k2 = K[:, 0], K[:, 1], K[:, 2]  # rows
+    c01, c12, c20 = np.cross(k0, k1), np.cross(k1, k2), np.cross(k2, k0)
+    det = np.einsum("ij,ij->i", k0, c12)
+    return (c12 * y[:, :1] + c20 * y[:, 1:2] + c01 * y[:, 2:]) / det[:, None]
+
+
 @register
 @dataclass(frozen=True)
 class ThermalCalibration:
@@ -186,7 +198,7 @@ class ThermalCalibration:
             for start in range(0, len(w), _CHUNK):
                 stop = start + _CHUNK
                 K, B = kg_to_kb(self.kg_at(t[start:stop], model, "extrapolate"))
-                out[start:stop] = np.linalg.solve(K, (w[start:stop] - B)[..., None])[..., 0]
+                out[start:stop] = _solve3(K, w[start:stop] - B)
         return out
 
     def apply(self, rec: Recording, **options) -> Recording:

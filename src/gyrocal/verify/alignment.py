@@ -34,7 +34,7 @@ from .whitenoise import second_difference_noise
 
 __all__ = ["Alignment", "AlignmentError", "align"]
 
-MIN_MAGNITUDE_SNR = 5.0  # rate-magnitude variation over the noise, each log
+MIN_MAGNITUDE_SNR = 3.0  # rate-magnitude variation over the per-sample noise, each log (static: about 0.7)
 MIN_PEAK = 0.3  # normalised magnitude correlation at the chosen offset
 MIN_ROTATION_SNR = 5.0  # rate RMS across the main turning direction over the noise
 MAX_ROTATION_STD_DEG = 2.0
@@ -235,7 +235,7 @@ def _rotation_excitation(v: np.ndarray, noise_test: np.ndarray, noise_ref: np.nd
             "mounting rotation about it cannot be found; record turns about a second axis as well")
 
 
-def _fit_pass(t_test, w_test, t_ref, w_ref, offset, drift, rot, margin, fit_drift, noise):
+def _fit_pass(t_test, w_test, t_ref, w_ref, offset, drift, rot, margin, fit_drift, noise, last: bool):
     tau = (t_test - offset) / (1.0 + drift * PPM)
     keep = (tau >= t_ref[0] + margin) & (tau <= t_ref[-1] - margin)
     if keep.sum() < MIN_OVERLAP_SAMPLES:
@@ -245,7 +245,8 @@ def _fit_pass(t_test, w_test, t_ref, w_ref, offset, drift, rot, margin, fit_drif
     if noise is not None:
         _rotation_excitation(interpolate(t_ref, w_ref, tau[keep])[0], *noise)
     tc = 0.5 * (t[0] + t[-1])
-    fit = refine(t, w, t_ref, w_ref, (tc - offset) / (1.0 + drift * PPM), drift, rot, fit_drift=fit_drift)
+    fit = refine(t, w, t_ref, w_ref, (tc - offset) / (1.0 + drift * PPM), drift, rot, fit_drift=fit_drift,
+                 covariance=last)
     new_offset = tc - fit.a * (1.0 + fit.drift_ppm * PPM)
     return fit, new_offset, t
 
@@ -298,9 +299,9 @@ def align(t_test, w_test, t_ref, w_ref, *, fit_drift: bool = True) -> Alignment:
     # First pass away from the reference's ends, then a last pass on every sample inside it.
     wide = min(1.0, 0.05 * (t_ref[-1] - t_ref[0]))
     fit, offset, _ = _fit_pass(t_test, w_test, t_ref, w_ref, offset, drift, rot, wide, fit_drift,
-                               (noise_test, noise_ref))
+                               (noise_test, noise_ref), last=False)
     fit, offset, t_used = _fit_pass(t_test, w_test, t_ref, w_ref, offset, fit.drift_ppm, fit.rotation,
-                                    0.0, fit_drift, None)
+                                    0.0, fit_drift, None, last=True)
     cov = _public_covariance(fit)
     tc = 0.5 * (t_used[0] + t_used[-1])  # where t - t_ref = tc - a, uncorrelated with the drift
     result = Alignment(

@@ -41,7 +41,7 @@ from .bootstrap import optimal_block_length
 __all__ = ["Refined", "interpolate", "refine", "smooth_slope"]
 
 PPM = 1e-6
-_CHUNK = 1 << 20
+_CHUNK = 1 << 18  # samples per pass of the normal equations: a (n, 3, 5) Jacobian of 31 MB
 _MAX_ITER = 50
 #: Width of the derivative filter behind the time columns of the Jacobian [s].
 SLOPE_WIDTH_S = 0.05
@@ -116,14 +116,6 @@ def smooth_slope(t_ref: np.ndarray, w_ref: np.ndarray, width_s: float = SLOPE_WI
     return savgol_filter(w_ref, n, 2, deriv=1, delta=dt, axis=0, mode="interp")
 
 
-def _cross_columns(v: np.ndarray) -> np.ndarray:
-    """(n, 3, 3): column j is ``v x e_j``, so that ``[...] @ theta = v x theta``."""
-    z = np.zeros(len(v))
-    return np.stack([np.stack([z, v[:, 2], -v[:, 1]], 1),
-                     np.stack([-v[:, 2], z, v[:, 0]], 1),
-                     np.stack([v[:, 1], -v[:, 0], z], 1)], axis=2)
-
-
 def _chunk(p, sl, a: float, drift: float, rot: np.ndarray, jacobian: bool, exact: bool = False):
     """Residuals (n, 3) of a chunk of samples and their smoothed Jacobian J~ (n, 3, 5) when
     asked; with `exact`, the Jacobian of the interpolant itself instead (two-point slopes)."""
@@ -138,7 +130,9 @@ def _chunk(p, sl, a: float, drift: float, rot: np.ndarray, jacobian: bool, exact
     jac = np.empty((len(u), 3, 5))
     jac[:, :, 0] = -rs
     jac[:, :, 1] = -rs * dtau_ddrift[:, None]
-    jac[:, :, 2:] = np.einsum("ij,njk->nik", rot, _cross_columns(v))  # e = w - R(v + theta x v)
+    rv = v @ rot.T
+    for j in range(3):  # e = w - R (v + theta x v); R (v x e_j) = (R v) x (R e_j)
+        jac[:, :, 2 + j] = np.cross(rv, rot[:, j])
     return e, jac
 
 
@@ -148,9 +142,10 @@ def _normal_equations(p, a, drift, rot, fit_drift: bool):
     h, g, cost = np.zeros((5, 5)), np.zeros(5), 0.0
     for i in range(0, n, _CHUNK):
         e, jac = _chunk(p, slice(i, i + _CHUNK), a, drift, rot, True)
-        h += np.einsum("nip,niq->pq", jac, jac)
-        g += np.einsum("nip,ni->p", jac, e)
-        cost += float(np.sum(e * e))
+        flat = jac.reshape(-1, 5)
+        h += flat.T @ flat
+        g += flat.T @ e.ravel()
+        cost += float(e.ravel() @ e.ravel())
     if not fit_drift:
         h[1, :], h[:, 1], g[1] = 0.0, 0.0, 0.0
         h[1, 1] = 1.0
@@ -203,8 +198,9 @@ def _covariances(p, a, drift, rot, fit_drift: bool):
     for i in range(0, n, _CHUNK):
         sl = slice(i, i + _CHUNK)
         e, jac = _chunk(p, sl, a, drift, rot, True)
-        bread += np.einsum("nip,niq->pq", jac, _chunk(p, sl, a, drift, rot, True, exact=True)[1])
-        gram += np.einsum("nip,niq->pq", jac, jac)
+        flat = jac.reshape(-1, 5)
+        bread += flat.T @ _chunk(p, sl, a, drift, rot, True, exact=True)[1].reshape(-1, 5)
+        gram += flat.T @ flat
         part = np.einsum("nip,ni->np", jac, e)
         scores[i // micro:(i + len(e) - 1) // micro + 1] = np.add.reduceat(part, np.arange(0, len(e), micro), axis=0)
         sq += np.sum(e * e, axis=0)
@@ -234,7 +230,7 @@ def _inflated(white: np.ndarray, pulls: np.ndarray) -> np.ndarray:
 
 
 def refine(t_test, w_test, t_ref, w_ref, a0: float, drift0: float, rot0: np.ndarray, *,
-           fit_drift: bool = True) -> Refined:
+           fit_drift: bool = True, covariance: bool = True) -> Refined:
     """Least-squares offset, drift and rotation from a starting point.
 
     Parameters
@@ -253,10 +249,16 @@ def refine(t_test, w_test, t_ref, w_ref, a0: float, drift0: float, rot0: np.ndar
         Starting rotation, reference frame to test frame.
     fit_drift : bool
         False holds the drift at `drift0` (a short log cannot measure it).
+    covariance : bool
+        False skips the covariance (NaN), for a pass whose result only starts another.
     """
     tc = 0.5 * (t_test[0] + t_test[-1])
     p = {"u": t_test - tc, "w": w_test, "t_ref": t_ref, "w_ref": w_ref, "slope": smooth_slope(t_ref, w_ref)}
     a, drift, rot, iterations = _gauss_newton(p, float(a0), float(drift0), np.asarray(rot0, float), fit_drift)
+    if not covariance:
+        nan = np.full((5, 5), np.nan)
+        return Refined(a=a, drift_ppm=drift, rotation=rot, covariance=nan, covariance_white=nan,
+                       residual_rms=np.full(3, np.nan), block=0, iterations=iterations)
     sandwich, white, rms, block = _covariances(p, a, drift, rot, fit_drift)
     return Refined(a=a, drift_ppm=drift, rotation=rot, covariance=sandwich, covariance_white=white,
                    residual_rms=rms, block=block, iterations=iterations)

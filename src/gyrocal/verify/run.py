@@ -27,7 +27,7 @@ OVERLAP_WARNING = 0.9  # fraction of the test log the reference should cover
 FIT_WARNING = 3.0  # residual RMS over the noise of both sensors
 FLOOR_WARNING = 0.5  # share of the MSE after calibration that the reference's noise makes up
 WORSE_WARNING_PCT = 1.0  # MSE increase [%] that is worth a warning (when also beyond 2 sigma)
-UNRESOLVED_WARNING = 0.05  # share of it that motion too fast for the reference may add
+UNRESOLVED_WARNING = 0.02  # share of it that motion too fast for the reference may add
 
 
 @dataclass(frozen=True)
@@ -88,13 +88,13 @@ def _warnings(alignment, t_test, metrics, unresolved: np.ndarray, units: str) ->
         if s > FLOOR_WARNING:
             out.append(f"the reference's own noise makes up {100 * s:.0f} % of the MSE after calibration on the {ax} "
                        "axis: a quieter reference (or a slower comparison) is needed to judge that axis")
-    flagged = [ax for ax, extra, mse in zip(AXES, unresolved, metrics.values["mse_after"])
-               if extra > UNRESOLVED_WARNING * mse]
-    if flagged:
+    if np.any(unresolved > UNRESOLVED_WARNING * metrics.values["mse_after"]):
+        sizes = ", ".join(f"{x:.2g}" for x in unresolved)
         out.append(
             f"the reference holds motion faster than its sample rate follows (vibration); interpolating it at the "
-            f"test times adds an error of its own to the MSE of axis {', '.join(flagged)}, so read those figures "
-            "as upper bounds, or compare with a faster reference")
+            f"test times adds an error of its own to every MSE, of the order of {sizes} ({units})^2 on x, y, z "
+            "(seen in the reference's own second differences; the true share can be larger). Read the figures as "
+            "upper bounds, or compare with a faster reference")
     return out
 
 

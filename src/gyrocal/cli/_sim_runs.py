@@ -1,0 +1,73 @@
+"""The protocol runs of ``gyrocal simulate`` that need no flag parsing of their own (kept apart to keep
+``sim_cmds`` small): each returns the recording and its truth, and fills the settings."""
+
+from __future__ import annotations
+
+import math
+
+from ..errors import InputError
+from ._options import numbers
+
+__all__ = ["multi_position", "profile_run", "turntable", "turntable_protocol"]
+
+
+def turntable_protocol(temps: str | None, rates: str | None, step_duration: float | None, temp_noise: float,
+                        temp_quantum: float | None):
+    """The full-temperature-range method's protocol; unset flags keep the paper's values."""
+    from ..simulation.turntable import TurntableProtocol
+
+    kw: dict = {}
+    if temps is not None:
+        kw["temps"] = tuple(numbers("--temps", temps))
+    if rates is not None:
+        kw["rates"] = tuple(numbers("--rates", rates))
+    if step_duration is not None:
+        kw["step_duration"] = step_duration
+    return TurntableProtocol(**kw, temp_noise=temp_noise, temp_quantum=temp_quantum)
+
+
+def multi_position(model, gyro_kw, flags: dict, sample_rate, rng, settings):
+    """A hand multi-position session of a whole IMU: the recording (with ax, ay, az), gyro model, facts.
+
+    `flags`: the command's parameters (``poses``, ``tilt``, ``still``, ``accel_noise_density``, ``misalignment``).
+    """
+    from ..simulation.multiposition import hand_session
+
+    density = 0.002 if flags["accel_noise_density"] is None else flags["accel_noise_density"]
+    rec, gyro, facts, extra = hand_session(model, gyro_kw=gyro_kw, poses=flags["poses"], tilt_deg=flags["tilt"],
+                                           still=flags["still"], accel_noise_std=density * math.sqrt(sample_rate),
+                                           misalignment_deg=flags["misalignment"], sample_rate=sample_rate, rng=rng)
+    settings.update(extra)
+    return rec, gyro, facts
+
+def turntable(gyro_kw, proto, sample_rate, rng, settings):
+    """A turntable session of a gyro following the thermal truth: recording, model at 25 degC, facts."""
+    import numpy as np
+
+    from ..models import Affine
+    from ..simulation import VirtualGyro
+    from ..simulation.thermal_truth import ThermalTruth
+    from ..simulation.turntable import simulate_turntable
+
+    thermal = ThermalTruth()
+    K, B = thermal(np.array([thermal.ref_temp]))
+    model = Affine(K[0], B[0])
+    rec = simulate_turntable(VirtualGyro(model, thermal=thermal, **gyro_kw), proto, sample_rate=sample_rate, rng=rng)
+    settings.update(temps_degC=list(proto.temps), rates_deg_s=list(proto.rates), axes=list(proto.axes),
+                    step_duration_s=proto.step_duration, table_tau_s=proto.table_tau,
+                    temp_noise_degC=proto.temp_noise, temp_quantum_degC=proto.temp_quantum)
+    return rec, model, {"thermal": thermal.to_dict()}
+
+
+def profile_run(model, gyro_kw, profile, profile_units, duration, sample_rate, rng, settings):
+    """A recording of a rate profile read from a CSV file."""
+    from ..io import read_profile
+    from ..simulation import VirtualGyro
+    from ..simulation.profiles import simulate_profile
+
+    if profile is None or duration is None:
+        raise InputError("--protocol profile needs --profile FILE.csv and --duration SECONDS")
+    rec, true_rates = simulate_profile(VirtualGyro(model, **gyro_kw), read_profile(profile, units=profile_units),
+                                       duration=duration, sample_rate=sample_rate, rng=rng)
+    settings.update(profile=str(profile), duration_s=duration)
+    return rec, {}, true_rates

@@ -1,0 +1,156 @@
+"""A whole-IMU calibration of a recording, as a calibration file holds it.
+
+:func:`calibrate_recording` runs :func:`~gyrocal.imu.session.calibrate_imu` on a
+:class:`~gyrocal.recording.Recording` (on the sensor's own clock when its stamps are receive
+times, leaving out pose pairs across lost samples) and builds the
+:class:`~gyrocal.calibration.Calibration`: ``correction`` and ``parameters`` are the gyro's, in
+the conventions of the other methods (``w_true = matrix @ (raw - offset)``), and the
+``accelerometer`` section holds the accelerometer's correction, its parameters with their
+covariance, how well they fit, the poses, and the gyro's g-sensitivity when it was fitted.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..calibration import Calibration
+from ..errors import InputError
+from ..models import KG_INDEX, Affine, ScaleBias
+from ..observed import observe
+from ..recording import Recording
+from ..timebase import TimeBase
+from ..units import parse_rate_unit
+from .filedoc import accelerometer_section, gyro_fit_section
+from .session import ImuCalibrationResult, calibrate_imu
+
+__all__ = ["ImuRun", "accel_scale", "calibrate_recording", "plausibility"]
+
+ACCEL_OUTPUT_UNITS = ("m/s^2", "g")
+#: A gap of at most this many lost samples is integrated across (its trapezoid error is third order in
+#: its length, below the noise of a hand move); a pose pair across a longer one is left out.
+MAX_LOST = 2
+
+
+@dataclass(frozen=True)
+class ImuRun:
+    """A recording's whole-IMU calibration.
+
+    Attributes
+    ----------
+    result : ImuCalibrationResult
+        The fits (internal units: gyro rad/s or counts, accelerometer m/s^2 or counts).
+    calibration : Calibration
+        The calibration file's content.
+    time_base : TimeBase
+    """
+
+    result: ImuCalibrationResult
+    calibration: Calibration
+    time_base: TimeBase
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        """The fits' warnings, and scale factors far from 1 in physical units (a declared unit that is wrong)."""
+        return self.result.warnings + plausibility(self.calibration)
+
+
+#: Scale factors in physical units further than this from 1 point to a declared unit that is wrong.
+SCALE_PLAUSIBLE = 0.2
+
+
+def plausibility(cal: Calibration) -> tuple[str, ...]:
+    """Warnings for scale factors far from 1 when both ends are physical units (a wrong --units or --accel-units)."""
+    out = []
+    if cal.input_units != "counts":
+        k = np.abs(np.diag(cal.correction[0]))
+        if np.any(np.abs(k - 1) > SCALE_PLAUSIBLE):
+            out.append(f"the gyro's scale factors are {', '.join(f'{v:.4g}' for v in k)} {cal.output_units} per "
+                       f"{cal.input_units}, far from 1: is the gyro's unit right? (57.3: deg/s read as rad/s)")
+    part = cal.accelerometer
+    if part is not None and part["units"]["input"] != "counts":
+        units = part["units"]
+        k = np.abs(np.diag(np.asarray(part["parameters"]["matrix"], dtype=float)))  # m/s^2 per m/s^2 as read
+        if np.any(np.abs(k - 1) > SCALE_PLAUSIBLE):
+            out.append(f"the accelerometer's scale factors are {', '.join(f'{v:.4g}' for v in k)}, far from 1: is "
+                       f"--accel-units {units['input']} right? (9.8: g read as m/s^2)")
+    return tuple(out)
+
+
+def accel_scale(units: str, sensitivity: float | None, gravity: float) -> float:
+    """Internal accelerometer units (m/s^2, or counts without a sensitivity) per unit of `units`."""
+    if units == "counts":
+        return 1.0 if sensitivity is None else gravity / sensitivity
+    return {"m/s^2": 1.0, "g": gravity}[units]
+
+
+def calibrate_recording(rec: Recording, *, windows=None, gravity: float = 9.80665, accel_model="auto",
+                        gyro_model="auto", g_sensitivity: bool = False, min_static: float = 1.0,
+                        output_units: str | None = None, accel_output_units: str = "m/s^2") -> ImuRun:
+    """Calibrate the gyro and the accelerometer of a hand session.
+
+    Parameters
+    ----------
+    rec : Recording
+        With accelerometer columns (``rec.accel``).
+    windows : sequence of Window, optional
+        Still poses and turns chosen by hand (imucal's section list makes a Ferraris session).
+    gravity : float
+        Local gravity [m/s^2] (it is also one ``g`` for readings and output in g).
+    accel_model, gyro_model, g_sensitivity, min_static :
+        See :func:`gyrocal.imu.session.calibrate_imu`.
+    output_units : {"rad/s", "deg/s"}, optional
+        Of the corrected rates; default the data's, deg/s for counts.
+    accel_output_units : {"m/s^2", "g"}
+        Of the corrected accelerations.
+    """
+    if rec.accel is None:
+        raise InputError("the recording has no accelerometer columns; a whole-IMU calibration needs them",
+                         param="accel_units", hint="give {param} (m/s^2, g or counts) and map ax, ay, az if their "
+                         "names are not found (--columns ax=...)")
+    if accel_output_units not in ACCEL_OUTPUT_UNITS:
+        raise InputError(f"{{param}} must be m/s^2 or g, got {accel_output_units!r}", param="accel_output_units",
+                         value=accel_output_units)
+    out_units = parse_rate_unit(output_units or ("deg/s" if rec.source_units == "counts" else rec.source_units),
+                                "output_units")
+    tb = rec.time_base()
+    clock = tb.clock_times()
+    result = calibrate_imu(rec.t if clock is None else clock, rec.gyro, rec.accel, gravity=gravity, windows=windows,
+                           accel_model=accel_model, gyro_model=gyro_model, g_sensitivity=g_sensitivity,
+                           min_static=min_static, gaps=[g.index for g in tb.gaps if g.lost > MAX_LOST])
+    return ImuRun(result, _calibration(result, rec, tb, out_units, accel_output_units, gravity), tb)
+
+
+def _gyro_model(result: ImuCalibrationResult):
+    """The gyro model and its covariance in that model's parameter order (internal units)."""
+    fit = result.gyro
+    cov = fit.covariance[:12, :12] if fit.model == "affine" else fit.covariance[:6, :6]
+    if fit.model == "scale":
+        model = ScaleBias(k=np.diag(fit.matrix), b=-fit.offset)  # Wang et al., eq. 1: b = -offset
+        jac = np.diag([1.0, 1.0, 1.0, -1.0, -1.0, -1.0])
+        return model, jac @ cov @ jac.T
+    model = Affine.from_canonical(fit.matrix, fit.offset)
+    k = model.K
+    jac = np.zeros((12, 12))
+    for row, (r, c) in enumerate(KG_INDEX):  # dK = -K dA K, with A row-major in the fit
+        jac[row, :9] = -np.outer(k[r, :], k[:, c]).ravel()
+    jac[9:, 9:] = np.eye(3)
+    return model, jac @ cov @ jac.T
+
+
+def _calibration(result, rec: Recording, tb: TimeBase, out_units: str, accel_out: str, gravity: float) -> Calibration:
+    model, cov = _gyro_model(result)
+    input_units = rec.source_units
+    sensitivity = rec.sensitivity if input_units == "counts" else None
+    cal = Calibration(model=model, input_units=input_units, output_units=out_units, sensitivity=sensitivity,
+                      method="ferraris" if result.kind == "ferraris" else "multi-position", covariance=cov)
+    noise = np.sqrt(np.mean([s.gyro_std**2 for s in result.statics], axis=0))
+    windows = [{"start": s.start, "stop": s.stop, "kind": "static", "label": s.label or f"pose {i + 1}"}
+               for i, s in enumerate(result.statics)]
+    windows += [{"start": t.start, "stop": t.stop, "kind": "rotation", "label": t.label,
+                 "angle_deg": float(np.degrees(t.angle))} for t in result.turns]
+    observed = {**observe(rec.gyro / cal.input_scale, rec.sample_rate, input_units),
+                "noise_std": (noise / cal.input_scale).tolist(), "time_base": tb.to_document()}
+    return replace(cal, noise_std=noise, windows=tuple(windows), observed=observed, fit=gyro_fit_section(result),
+                   accelerometer=accelerometer_section(result, rec, cal, accel_out, gravity))
