@@ -1,7 +1,8 @@
 """The guided multi-position hand session of a whole IMU, judged live, to a finished calibration.
 
 Independent references: the project's hand-session simulator (gyrocal.simulation.multiposition) with its
-truth (accelerometer correction, gyro correction) and the true still span of every pose; the person's
+truth (accelerometer correction, gyro correction; compared in units of the reported 1-sigma by
+gyrocal.capture.simulated_imu.z_scores) and the true still span of every pose; the person's
 mistakes are put into the simulated motion (a pose repeated, a pose held too briefly), so the refusals
 expected are known without the guide. The final calibration must find the simulator's truth within
 4 sigma of its own reported covariance, per parameter (a scan of 40 seeds, tools/guided_imu_scan.py,
@@ -16,19 +17,9 @@ import numpy as np
 import pytest
 
 from gyrocal.capture.pose_guide import CANDIDATES, PoseGuide, describe, guided_directions, plan_directions
-from gyrocal.capture.simulated_imu import simulate_device_imu_session
+from gyrocal.capture.simulated_imu import simulate_device_imu_session, z_scores
 from gyrocal.imu.run import calibrate_recording
 from gyrocal.recording import Recording
-
-G = 9.80665
-
-
-def as_recording(s, lo: int = 0, hi: int | None = None) -> Recording:
-    """Samples lo:hi of a simulated device session, read as the capture reads them (counts with sensitivities)."""
-    hi = len(s) if hi is None else hi
-    return Recording(t=(s.t_us[lo:hi] - s.t_us[0]) * 1e-6, gyro=np.radians(s.raw[lo:hi] / s.sensitivity),
-                     source_units="counts", sensitivity=s.sensitivity, accel=s.accel[lo:hi] * (G / s.accel_sensitivity),
-                     accel_units="m/s^2", accel_source_units="counts", accel_sensitivity=s.accel_sensitivity)
 
 
 def play(guide: PoseGuide, s, chunk: int = 23):
@@ -36,22 +27,10 @@ def play(guide: PoseGuide, s, chunk: int = 23):
     events = list(guide.start())
     for n in range(chunk, len(s) + chunk, chunk):
         start = guide.keep_from
-        events += guide.update(as_recording(s, start, min(n, len(s))), offset=start)
+        events += guide.update(s.recording(start, min(n, len(s))), offset=start)
         if guide.complete:
             break
     return events
-
-
-def z_scores(run, truth) -> np.ndarray:
-    """(estimate - truth) / reported 1-sigma of the accelerometer's 9 and the gyro's 12 parameters."""
-    a, g = run.result.accel, run.result.gyro
-    xyz = "xyz".index
-    est = [a.matrix[xyz(n[2]), xyz(n[3])] if n[0] == "A" else a.offset[xyz(n[2])] for n in a.param_names]
-    tru = [truth["accel_matrix"][xyz(n[2]), xyz(n[3])] if n[0] == "A" else truth["accel_offset"][xyz(n[2])]
-           for n in a.param_names]
-    za = (np.array(est) - tru) / a.std
-    zg = (np.r_[g.matrix.ravel(), g.offset] - np.r_[truth["gyro_matrix"].ravel(), truth["gyro_offset"]]) / g.std[:12]
-    return np.r_[za, zg]
 
 
 def test_plan_starts_with_the_faces_and_every_target_has_a_name():
@@ -78,8 +57,8 @@ def test_guided_session_refuses_a_repeat_and_a_short_hold_then_calibrates():
     held = [w for i, w in enumerate(s.windows) if i not in (6, 10)]
     for got, true in zip(guide.windows(), held):
         assert true.start <= got.start and got.stop <= true.stop and got.stop - got.start >= 1.0 * s.sample_rate
-    run = calibrate_recording(as_recording(s), windows=guide.windows())
-    z = z_scores(run, s.truth)
+    run = calibrate_recording(s.recording(), windows=guide.windows())
+    z = z_scores(run.result, s.truth)
     assert np.all(np.abs(z) <= 4), z
 
 
@@ -90,11 +69,11 @@ def test_redo_takes_the_last_pose_back():
     events = list(guide.start())
     third = s.windows[2]
     n = third.start + int(2.5 * s.sample_rate)  # 2.5 s into the third pose: it has been accepted
-    events += guide.update(as_recording(s, 0, n))
+    events += guide.update(s.recording(0, n))
     assert [e.kind for e in events].count("accepted") == 3
     events = guide.redo(n)
     assert events[0].text == "redo pose 3: move the board, then hold it still again" and len(guide.accepted) == 2
-    events = guide.update(as_recording(s, guide.keep_from), offset=guide.keep_from)
+    events = guide.update(s.recording(guide.keep_from), offset=guide.keep_from)
     accepted = [e.text for e in events if e.kind == "accepted"]
     assert len(accepted) == 1 and accepted[0].startswith("pose 3: accepted: z down")
     assert guide.windows()[2].start >= s.windows[3].start  # the pose held again, not the one taken back

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import binascii
 import struct
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -355,8 +355,11 @@ class FrameDecoder:
         frame = cls.parse(payload)
         st.frames += 1
         st.by_type[cls.__name__] = st.by_type.get(cls.__name__, 0) + 1
-        if isinstance(frame, (Sample, ImuSample)):
-            frame = replace(frame, t_us=self._unwrap(frame.t_us))
+        if cls is Sample:
+            frame = Sample(frame.seq, self._unwrap(frame.t_us), frame.raw, frame.temp)
+            self._track(frame.seq)
+        elif cls is ImuSample:
+            frame = ImuSample(frame.seq, self._unwrap(frame.t_us), frame.raw, frame.accel, frame.temp)
             self._track(frame.seq)
         return frame
 

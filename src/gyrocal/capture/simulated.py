@@ -16,6 +16,7 @@ import numpy as np
 
 from .._validation import positive
 from ..models import ScaleBias
+from ..recording import Recording
 from ..simulation import ServoProtocol, VirtualGyro, simulate_servo
 from ..windows import Window
 
@@ -84,6 +85,17 @@ class DeviceSession:
     @property
     def turns(self) -> tuple[Window, ...]:
         return tuple(w for w in self.windows if w.kind == "rotation")
+
+    def recording(self, start: int = 0, stop: int | None = None, gravity: float = 9.80665) -> Recording:
+        """Samples ``start:stop`` as ``gyrocal capture`` reads them: counts at the session's sensitivities, in
+        rad/s and m/s^2, the time from the first sample of the session [s]."""
+        part = slice(start, len(self) if stop is None else stop)
+        kw = {}
+        if self.accel is not None:
+            kw = dict(accel=self.accel[part] * (gravity / self.accel_sensitivity), accel_units="m/s^2",
+                      accel_source_units="counts", accel_sensitivity=self.accel_sensitivity)
+        return Recording(t=(self.t_us[part] - self.t_us[0]) * 1e-6, gyro=np.radians(self.raw[part] / self.sensitivity),
+                         source_units="counts", sensitivity=self.sensitivity, **kw)
 
 
 def simulate_device_session(

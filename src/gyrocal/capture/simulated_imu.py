@@ -30,7 +30,7 @@ from ..simulation.multiposition import (
 from ..windows import Window
 from .simulated import MPU6050_ACCEL_SENSITIVITY, MPU6050_SENSITIVITY, DeviceSession, _temperature, counts
 
-__all__ = ["orientation_up", "simulate_device_imu_session"]
+__all__ = ["orientation_up", "simulate_device_imu_session", "z_scores"]
 
 #: MPU-6050 noise densities: gyro 0.005 deg/s/sqrt(Hz), accelerometer 400 ug/sqrt(Hz).
 GYRO_DENSITY = math.radians(0.005)
@@ -104,3 +104,20 @@ def simulate_device_imu_session(directions: Sequence, *, rng: np.random.Generato
     return DeviceSession(counts(np.degrees(gyro_r) * sensitivity), t_us, _temperature(temp, n), fs, sensitivity,
                          gyro, windows, accel=counts(accel_r / g * accel_sensitivity),
                          accel_sensitivity=int(accel_sensitivity), truth=dict(s.truth))
+
+
+def z_scores(result, truth: dict) -> np.ndarray:
+    """``(estimate - truth) / reported 1-sigma`` of a whole-IMU calibration (:class:`~gyrocal.imu.session.
+    ImuCalibrationResult`, internal units) of a simulated session: the accelerometer's parameters in its
+    model's order (``param_names``), then the gyro's correction matrix (row-major) and offset."""
+    a, g = result.accel, result.gyro
+    xyz = "xyz".index
+
+    def entry(m, o, name):
+        return m[xyz(name[2]), xyz(name[3])] if name[0] == "A" else o[xyz(name[2])]
+
+    za = [(entry(a.matrix, a.offset, n) - entry(truth["accel_matrix"], truth["accel_offset"], n)) / sd
+          for n, sd in zip(a.param_names, a.std)]
+    n = g.matrix.size
+    zg = (np.r_[g.matrix.ravel(), g.offset] - np.r_[truth["gyro_matrix"].ravel(), truth["gyro_offset"]]) / g.std[:n + 3]
+    return np.r_[za, zg]
