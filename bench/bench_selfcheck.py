@@ -13,7 +13,7 @@ optionally with receive-time stamps, then times in the same process, alternating
   stamps (rate, gaps, late deliveries, the sensor clock rebuilt), turns across gaps screened,
   goodness of fit with Birge scaling, plausibility of k, the ``fit`` and ``observed`` sections;
 * the plain estimate, ``checks=False, long_run=False``: white-noise covariance, plain means, as
-  before issue 10 (to show the cost of everything together).
+  before the self-checks existed (to show the cost of everything together).
 
 Prints the best CPU time of `repeat` runs of each, for the speed and the angle reference, and what
 the checks add, against the calibration alone and against reading the CSV plus calibrating (what
