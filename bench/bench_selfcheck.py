@@ -86,8 +86,8 @@ def main() -> None:
         extra = checked - estimate
         print(f"{name} ({len(run.observations)} windows): calibrate {estimate:.3f} s without the self-checks, "
               f"{checked:.3f} s with them: the self-checks cost {100 * extra / estimate:.1f} % of the calibration "
-              f"(target < 10 %), {100 * extra / (estimate + read):.1f} % of reading + calibrating. Everything this "
-              f"issue added (self-checks, ripple and long-run variances: {checked:.3f} s against the plain "
+              f"(target < 10 %), {100 * extra / (estimate + read):.1f} % of reading + calibrating. Everything added "
+              f"to the plain estimate (self-checks, ripple and long-run variances: {checked:.3f} s against the plain "
               f"estimate's {plain:.3f} s): {100 * (checked / plain - 1):.1f} % of the calibration, "
               f"{100 * (checked - plain) / (plain + read):.1f} % of reading + calibrating")
 
