@@ -334,3 +334,57 @@ def test_segments_plot_marks_ignored_turns_and_nothing_covers_the_data(session, 
     assert ax.get_xlim()[0] < 100  # seconds since the first sample, not 1.7e9
     code, _, err = invoke("segments", epoch, "--units", "deg/s", "--angle", "90", "--plot", tmp_path / "s.png")
     assert code == 0 and (tmp_path / "s.png").stat().st_size > 10_000, err
+
+
+# ---------------------------------------------------------------- simulate
+
+
+def test_simulate_rates_with_their_units_and_counts_with_a_sensitivity(tmp_path):
+    """Reference: the truth sidecar, which stores SI; 2 deg/s of noise is 0.0349 rad/s."""
+    from gyrocal.files import load
+    from gyrocal.io import read_recording
+    from gyrocal.simulation.truth import SimulationTruth
+
+    code, _, err = invoke("simulate", "-o", tmp_path / "a.csv", "--noise", "2deg/s", "--b", "0.5,0.1,0.2deg/s",
+                          "--speed", "1.0471975511965976rad/s")
+    assert code == 0, err
+    truth = load(tmp_path / "a.truth.json", SimulationTruth)
+    np.testing.assert_allclose(truth.settings["noise_std"], math.radians(2.0), rtol=1e-12)
+    np.testing.assert_allclose(truth.model.b, np.radians([0.5, 0.1, 0.2]), rtol=1e-12)
+    assert truth.settings["speed_deg_s"] == pytest.approx(60.0)
+    assert "--noise must be a number" in refused("simulate", "-o", tmp_path / "b.csv", "--noise", "loud")
+    line = refused("simulate", "-o", tmp_path / "c.csv", "--units", "counts")
+    assert "--units counts needs the sensitivity" in line and "--sensitivity" in line
+    code, _, err = invoke("simulate", "-o", tmp_path / "c.csv", "--units", "counts", "--sensitivity", "131")
+    assert code == 0, err
+    raw = read_recording(tmp_path / "c.csv", units="counts")
+    deg = read_recording(tmp_path / "c.csv", units="counts", sensitivity=131)
+    assert raw.units == "counts" and np.array_equal(raw.gyro, np.round(raw.gyro))
+    assert (tmp_path / "c.csv").read_text().startswith("# gyrocal simulate --protocol servo; gyro in counts (131 LSB")
+    assert np.abs(np.degrees(deg.gyro)).max() > 55  # the 60 deg/s turns, through the sensitivity
+
+
+def test_a_large_session_says_its_size_first(tmp_path):
+    code, out, err = invoke("simulate", "-o", tmp_path / "s.csv", "--protocol", "static", "--duration", "5100")
+    assert code == 0, err
+    first = out.splitlines()[0]
+    assert first.startswith("simulating 1.02 M samples (1.42 h of data at 200 Hz): about ") and "MB of CSV" in first
+    estimate = float(first.split("about ")[1].split(" MB")[0])
+    actual = (tmp_path / "s.csv").stat().st_size / 1e6
+    assert 0.7 < estimate / actual < 1.4, (estimate, actual)
+
+
+def test_skip_rows_reaches_noise_and_thermal(tmp_path):
+    code, _, err = invoke("simulate", "-o", tmp_path / "still.csv", "--protocol", "static", "--duration", "60")
+    assert code == 0, err
+    lines = [line for line in (tmp_path / "still.csv").read_text().splitlines() if not line.startswith("#")]
+    pre = tmp_path / "pre.csv"
+    width = len(lines[0].split(","))  # a preamble as wide as the table: only the user knows where it ends
+    pre.write_text(",".join(["sensor"] + ["x"] * (width - 1)) + "\n" + ",".join(map(str, range(width))) + "\n"
+                   + "\n".join(lines) + "\n")
+    assert "--skip-rows N" in refused("noise", pre, "--units", "deg/s")
+    code, out, err = invoke("noise", pre, "--units", "deg/s", "--skip-rows", "2")
+    assert code == 0, err
+    for command in ("thermal", "thermal-report"):
+        code, out, _ = invoke(command, "--help")
+        assert code == 0 and "--skip-rows" in out

@@ -37,6 +37,19 @@ def test_real_ulog_holds_three_gyros_by_device_id():
     assert 39 < read_flight_log(ULOG, imu=0)[0].temp.mean() < 41  # the first IMU runs hot (heater)
 
 
+def test_ulog_accelerometer_of_the_same_device():
+    from pyulog import ULog
+
+    rec, info = read_flight_log(ULOG, imu=1, accel_units="m/s^2")
+    topic = next(d for d in ULog(str(ULOG)).data_list if d.name == "sensor_accel" and d.multi_id == 1)
+    assert info["accel_device_id"] == info["device_id"] == 3670050
+    # the sample logs accel and gyro of one IMU at the same stamps: the values come through as they are
+    np.testing.assert_allclose(rec.accel[:, 2], topic.data["z"].astype(float))
+    assert rec.accel_source_units == "m/s^2" and 9 < np.abs(rec.accel).max() < 11  # gravity
+    with pytest.raises(UnitError, match="m/s\\^2"):
+        read_flight_log(ULOG, imu=1, accel_units="g")
+
+
 def test_ulog_through_read_recording():
     rec = read_recording(ULOG, units="rad/s", imu=2)
     assert len(rec) == 6 and rec.has_time

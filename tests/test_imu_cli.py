@@ -190,3 +190,76 @@ def test_raw_counts_with_an_unsigned_offset_metadata_lines_and_no_header(tmp_pat
     assert np.all(np.abs(k - np.radians(1 / 131.0)) < 4.5 * std_k)
     offset = np.array(cal.accelerometer["correction"]["offset"])
     assert np.all(np.abs(offset - 32768) < 4.5 * np.array([cal.accelerometer["std"][f"o_{c}"] for c in "xyz"]))
+
+
+def test_accelerometer_in_a_log_of_its_own(session, tmp_path):
+    """imu_tk's layout: gyro and accelerometer in two headerless files of 'time x y z'. Reference: the same
+    session with both sensors in one file gives the same calibration (to rounding of the written digits)."""
+    rec, cal_path, _, _ = session
+    data = read_recording(rec, units="deg/s", accel_units="m/s^2")
+    gyro_file, acc_file = tmp_path / "gyro.mat", tmp_path / "acc.mat"
+    gyro_file.write_text("".join(f"  {t:.6f}  {x:.9f}  {y:.9f}  {z:.9f}\n" for t, (x, y, z) in
+                                 zip(data.t, np.degrees(data.gyro))))
+    acc_file.write_text("".join(f"  {t:.6f}  {x:.9f}  {y:.9f}  {z:.9f}\n" for t, (x, y, z) in zip(data.t, data.accel)))
+    out = tmp_path / "two.json"
+    code, _, err = invoke("imu", gyro_file, "--columns", "t=1,gx=2,gy=3,gz=4", "--units", "deg/s", "--accel-log",
+                          acc_file, "--accel-columns", "t=1,ax=2,ay=3,az=4", "--accel-units", "m/s^2", "-o", out)
+    assert code == 0, err
+    one, two = load(cal_path), load(out)
+    np.testing.assert_allclose(two.correction[0], one.correction[0], atol=1e-6)
+    np.testing.assert_allclose(two.accelerometer["correction"]["matrix"], one.accelerometer["correction"]["matrix"],
+                               atol=1e-6)
+    line = refused("imu", gyro_file, "--columns", "t=1,gx=2,gy=3,gz=4", "--units", "deg/s", "--accel-units",
+                   "m/s^2", "--accel-columns", "t=1,ax=2,ay=3,az=4")
+    assert "--accel-columns is for --accel-log" in line
+
+
+def test_accelerometer_log_on_other_stamps_is_interpolated_onto_the_gyro(tmp_path):
+    """Reference: a linear signal, which linear interpolation reproduces exactly; logs that barely overlap are
+    refused."""
+    from gyrocal.errors import InputError
+    from gyrocal.io import attach_accelerometer
+    from gyrocal.recording import Recording
+
+    t = np.arange(1000) / 100.0
+    rec = Recording(t=t, gyro=np.zeros((1000, 3)))
+    ta = t[:900] + 0.005
+    acc = tmp_path / "acc.txt"
+    acc.write_text("".join(f"{x:.4f} {1 + x:.6f} {2 * x:.6f} {0.5:.6f}\n" for x in ta))
+    joined = attach_accelerometer(rec, acc, accel_units="g", columns="t=1,ax=2,ay=3,az=4", gravity=9.8)
+    assert joined.t[0] >= ta[0] and joined.t[-1] <= ta[-1] and len(joined) == 899
+    np.testing.assert_allclose(joined.accel[:, 0], 9.8 * (1 + joined.t), atol=1e-9)
+    np.testing.assert_allclose(joined.accel[:, 1], 9.8 * 2 * joined.t, atol=1e-9)
+    acc.write_text("".join(f"{x:.4f} 0 0 1\n" for x in ta[:300]))
+    with pytest.raises(InputError, match="share less than half the session"):
+        attach_accelerometer(rec, acc, accel_units="g", columns="t=1,ax=2,ay=3,az=4")
+
+
+def test_a_wrong_declared_unit_is_pointed_out(session, tmp_path):
+    """deg/s data declared as rad/s and m/s^2 data declared as g: the fit still closes, with scale factors near
+    1/57.3 and 1/9.8, and a warning names each unit."""
+    rec, _, _, _ = session
+    code, _, err = invoke("imu", rec, "--units", "rad/s", "--no-unit-check", "--accel-units", "g")
+    assert code == 0, err
+    assert "is the gyro's unit right? (57.3: deg/s read as rad/s)" in err
+    assert "is --accel-units g right? (9.8: g read as m/s^2)" in err
+
+
+def test_g_sensitivity_flag_and_its_place_in_the_file(session, tmp_path):
+    """The simulated gyro has no g-sensitivity: the fitted one is zero within its 1-sigma (4.5 sigma), and the
+    file carries it where apply and the exports find it."""
+    rec, _, _, _ = session
+    out = tmp_path / "g.json"
+    code, stdout, err = invoke("imu", rec, "--units", "deg/s", "--accel-units", "m/s^2", "--g-sensitivity", "-o", out)
+    assert code == 0, err
+    assert "g-sensitivity: fitted from the still poses" in stdout
+    part = load(out).accelerometer["gyro_g_sensitivity"]
+    g, std = np.array(part["matrix"]), np.array(part["std"])
+    assert part["units"] == "deg/s per m/s^2" and np.all(np.abs(g) < 4.5 * std)
+
+
+def test_imucal_export_needs_both_sensors(tmp_path):
+    code, _, err = invoke("calibrate", "--example", "-o", tmp_path / "gyro.json")
+    assert code == 0, err
+    line = refused("export", tmp_path / "gyro.json", "--format", "imucal", "-o", tmp_path / "x.json")
+    assert "imucal's format holds the accelerometer and the gyro" in line and "gyrocal imu" in line

@@ -221,4 +221,4 @@ def test_fit_quality_round_trips_through_its_document(rng):
     doc = q.to_document()
     assert set(doc) >= {"chi2", "dof", "p_value", "birge_ratio", "covariance_scaled", "residuals", "warnings"}
     assert GoodnessOfFit.from_document(doc) == q
-    assert len(doc["residuals"]) == len(q.labels) and len(doc["residuals"][0]["z"]) == 3  # a static window first
+    assert len(doc["residuals"]) == len(q.labels) and len(doc["residuals"][0]) == 3  # a static window first

@@ -84,8 +84,8 @@ class GoodnessOfFit:
             "p_value": self.p_value,
             "birge_ratio": self.birge_ratio,
             "covariance_scaled": self.covariance_scaled,
-            "residuals": [{"window": i, "label": lab, "z": list(z)}
-                          for i, (lab, z) in enumerate(zip(self.labels, self.residuals))],
+            "residuals": [list(z) for z in self.residuals],
+            "labels": list(self.labels),
             "disagree": list(self.disagree),
             "warnings": list(self.warnings),
         }
@@ -99,8 +99,8 @@ class GoodnessOfFit:
             p_value=None if doc.get("p_value") is None else float(doc["p_value"]),
             birge_ratio=None if doc.get("birge_ratio") is None else float(doc["birge_ratio"]),
             covariance_scaled=bool(doc.get("covariance_scaled", False)),
-            labels=tuple(str(r.get("label", "")) for r in res),
-            residuals=tuple(tuple(float(v) for v in r["z"]) for r in res),
+            labels=tuple(str(lab) for lab in doc.get("labels") or [""] * len(res)),
+            residuals=tuple(tuple(float(v) for v in z) for z in res),
             disagree=tuple(int(i) for i in doc.get("disagree", ())),
             warnings=tuple(str(w) for w in doc.get("warnings", ())),
         )

@@ -174,12 +174,13 @@ class Section(Mapping):
 
 
 def _residuals(v):
-    """Residuals in noise units: numbers, or one ``{"window", "label", "z": [numbers]}`` object per window."""
-    if isinstance(v, tuple) and all(isinstance(r, Mapping) for r in v):
+    """Residuals in noise units: numbers, one list of numbers per window (of any length), or one
+    ``{"window", "label", "z": [numbers]}`` object per window."""
+    if isinstance(v, tuple) and v and all(isinstance(z, (tuple, Mapping)) for z in v):
         for r in v:  # plain Python: thousands of windows, a few numbers each
-            z = r.get("z", ())
+            z = r.get("z", ()) if isinstance(r, Mapping) else r
             if not isinstance(z, tuple) or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in z):
-                raise ValueError(f"must hold numbers 'z' in every window, got {_thaw(z)!r}")
+                raise ValueError(f"must hold numbers in every window, got {_thaw(z)!r}")
         return v
     return numbers((-1,))(v)
 
@@ -190,15 +191,15 @@ class FitQuality(Section):
     Documented keys: ``chi2``, ``dof`` (0: no residual degrees of freedom, nothing checked),
     ``chi2_per_dof``, ``p_value`` (null without dof), ``birge_ratio`` (sqrt(chi2 / dof)),
     ``covariance_scaled`` (whether ``covariance`` and ``std`` were scaled by chi2 / dof, as when
-    p < 0.001), ``residuals`` (per window in noise units: ``{"window", "label", "z"}``, one ``z``
-    for a turn, three for a static window), ``disagree`` (the windows that disagree most, when
-    flagged), ``warnings`` (list of text).
+    p < 0.001), ``residuals`` (one list per window, in the order of ``windows``, in noise units:
+    one value for a turn, three for a static window), ``labels`` (the windows' names),
+    ``disagree`` (the windows that disagree most, when flagged), ``warnings`` (list of text).
     """
 
     NAME = "fit"
     FIELDS = {"chi2": number(0), "dof": integer(0), "chi2_per_dof": number(0), "p_value": number(0, 1),
               "birge_ratio": number(0), "covariance_scaled": boolean, "residuals": _residuals,
-              "disagree": numbers((-1,), 0), "warnings": texts}
+              "labels": texts, "disagree": numbers((-1,), 0), "warnings": texts}
 
 
 class Observed(Section):

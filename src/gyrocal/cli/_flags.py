@@ -41,6 +41,8 @@ FLAGS: dict[str, str] = {
     "g_sensitivity": "--g-sensitivity",
     "min_static": "--min-static",
     "accel_output_units": "--accel-output-units",
+    "accel_log": "--accel-log",
+    "accel_columns": "--accel-columns",
     # apply, export
     "model": "--model",
     "out_of_range": "--out-of-range",

@@ -71,3 +71,40 @@ def noise_std(noise: float | None, density: str | None, sample_rate: float, defa
     if not (math.isfinite(value) and value >= 0):
         raise InputError(f"--noise must be >= 0 rad/s, got {value:g}")
     return np.full(3, value)
+
+
+#: Rate units a number on the command line may carry, in rad/s per unit.
+_RATE_UNITS = {"rad/s": 1.0, "deg/s": math.pi / 180.0, "dps": math.pi / 180.0, "\u00b0/s": math.pi / 180.0}
+
+
+def _split_unit(flag: str, text: str) -> tuple[str, str | None]:
+    raw = text.strip().replace(" ", "")
+    for unit in sorted(_RATE_UNITS, key=len, reverse=True):
+        if raw.lower().endswith(unit):
+            return raw[: -len(unit)], unit
+    if raw and raw[-1].isalpha():
+        if not any(c.isdigit() for c in raw):
+            raise InputError(f"{flag} must be a number, with a unit if you like (0.035rad/s, 2deg/s), got {text!r}")
+        raise InputError(f"{flag} {text!r}: the unit is not one of rad/s, deg/s, dps")
+    return raw, None
+
+
+def in_unit(flag: str, text: str | None, unit: str) -> float | None:
+    """A rate flag's number in `unit`: a bare number is already in it; ``2deg/s`` or ``0.035rad/s`` is converted."""
+    if text is None:
+        return None
+    raw, given_unit = _split_unit(flag, str(text))
+    try:
+        value = float(raw)
+    except ValueError:
+        raise InputError(f"{flag} must be a number, with a unit if you like (0.035rad/s, 2deg/s), got {text!r}") \
+            from None
+    return value * _RATE_UNITS[given_unit or unit] / _RATE_UNITS[unit]
+
+
+def triple_in_unit(flag: str, text: str | None, unit: str, default) -> list[float]:
+    """Three comma-separated rates in `unit`; one unit written after the last applies to all three."""
+    if text is None:
+        return list(default)
+    raw, given_unit = _split_unit(flag, text)
+    return [v * _RATE_UNITS[given_unit or unit] / _RATE_UNITS[unit] for v in triple(flag, raw, default)]

@@ -140,7 +140,7 @@ def _params_table(run, truth=None):
         table.add_row(*row)
     canon = Table()
     for label in ("matrix", "", "", "offset"):
-        canon.add_column(label, justify="right")
+        canon.add_column(label, justify="right", no_wrap=True)
     for r in range(3):
         canon.add_row(*[f"{v:.6g}" for v in matrix[r]], f"{offset[r]:.6g}")
     return table, canon
@@ -351,7 +351,7 @@ def segments(
     table = Table()
     for col in ("#", "kind", "turn", "start", "stop", "t0 [s]", "length [s]", f"angle [{angle_unit}]",
                 f"mean rate [{disp}]"):
-        table.add_column(escape(col), justify="right" if col not in ("kind", "turn") else "left")
+        table.add_column(escape(col), justify="right" if col not in ("kind", "turn") else "left", no_wrap=True)
     for i, w in enumerate(found):
         table.add_row(str(i), w.kind, _turn(w), str(w.start), str(w.stop), f"{rec.t[w.start]:.2f}",
                       f"{times[w.stop - 1] - times[w.start]:.2f}", *_measured(rec, w, baseline, times, disp))
@@ -360,7 +360,8 @@ def segments(
         console.print(f"{len(ignored)} ignored:")
         skipped = Table()
         for col in ("start", "stop", "turn", f"angle [{angle_unit}]", f"mean rate [{disp}]", "why"):
-            skipped.add_column(escape(col), justify="left" if col in ("turn", "why") else "right")
+            # numbers never wrap; the reason, words, may
+            skipped.add_column(escape(col), justify="left" if col in ("turn", "why") else "right", no_wrap=col != "why")
         for w, why in ignored:
             skipped.add_row(str(w.start), str(w.stop), _turn(w), *_measured(rec, w, baseline, times, disp), why)
         console.print(skipped)

@@ -147,6 +147,12 @@ def imu(
     accel_units: READING.AccelUnits = None,
     accel_sensitivity: READING.AccelSensitivity = None,
     gravity: READING.Gravity = 9.80665,
+    accel_log: Annotated[Optional[Path], typer.Option(
+        "--accel-log", help="The accelerometer's own log, when it is not in the gyro's (imu_tk keeps the two apart) "
+        "(default: none, ax ay az are in the recording).")] = None,
+    accel_columns: Annotated[Optional[str], typer.Option(
+        "--accel-columns", help="With --accel-log: its columns, e.g. t=1,ax=2,ay=3,az=4 (default: columns named "
+        "ax, ay, az).")] = None,
     windows: Annotated[Optional[Path], typer.Option(
         "--windows", help="Still poses (and turns) chosen by hand; imucal's section list makes a Ferraris "
         "session (default: none, the poses are detected).")] = None,
@@ -177,11 +183,20 @@ def imu(
     if accel_units is None:
         raise InputError("{param} is required: m/s^2, g or counts (the unit of the accelerometer columns)",
                          param="accel_units")
-    check_output(plot, flag="--plot", inputs=(recording, windows, output), force=True)
+    if accel_columns is not None and accel_log is None:
+        raise InputError("--accel-columns is for --accel-log; map the recording's own columns with --columns ax=...")
+    check_output(plot, flag="--plot", inputs=(recording, windows, output, accel_log), force=True)
     rec = read_from_flags(recording, units=units, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
                           sensitivity=sensitivity, output_units=output_units, topic=topic, saturation=saturation,
-                          no_unit_check=no_unit_check, accel_units=accel_units, accel_sensitivity=accel_sensitivity,
-                          gravity=gravity, need_accel=True)
+                          no_unit_check=no_unit_check, accel_units=None if accel_log else accel_units,
+                          accel_sensitivity=None if accel_log else accel_sensitivity, gravity=gravity,
+                          need_accel=accel_log is None)
+    if accel_log is not None:
+        from ..io import attach_accelerometer
+
+        rec = attach_accelerometer(rec, accel_log, accel_units=accel_units, columns=accel_columns, skip_rows=skip_rows,
+                                   sample_rate=sample_rate, accel_sensitivity=accel_sensitivity, gravity=gravity)
+
     win = None
     if windows is not None:
         from ..io import read_windows
@@ -191,7 +206,7 @@ def imu(
                               g_sensitivity=g_sensitivity, min_static=min_static, output_units=output_units,
                               accel_output_units=accel_output_units)
     doc = run.calibration.to_document()
-    check_output(output, inputs=(recording, windows), force=force, replaceable=same_document(doc),
+    check_output(output, inputs=(recording, windows, accel_log), force=force, replaceable=same_document(doc),
                  holds="a different calibration or another file")
     if plot is not None:
         from ..plotting import save_figure
@@ -207,7 +222,7 @@ def imu(
     _print_poses(run)
     _print_accel(run)
     _print_gyro(run)
-    for line in run.result.warnings:
+    for line in run.warnings:
         warn(line)
     if output is not None:
         console.print(f"wrote {output}" + (f" and {plot}" if plot is not None else ""), highlight=False)

@@ -59,6 +59,7 @@ def noise(
         help="Log at rest: CSV, Parquet, ROS/MCAP bag, PX4 .ulg, ArduPilot .bin.")],
     units: READING.Units = None,
     columns: READING.Columns = None,
+    skip_rows: READING.SkipRows = None,
     sample_rate: READING.SampleRate = None,
     sensitivity: READING.Sensitivity = None,
     output_units: READING.OutputUnits = None,
@@ -96,7 +97,8 @@ def noise(
         raise InputError("noise figures are physical quantities, so raw counts need their sensitivity",
                          param="sensitivity", hint="give {param} (LSB per --output-units, e.g. 131 for a +-250 deg/s "
                                                     "MPU-9250)")
-    rec = read_from_flags(recording, units=unit, columns=columns, sample_rate=sample_rate, sensitivity=sensitivity,
+    rec = read_from_flags(recording, units=unit, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
+                          sensitivity=sensitivity,
                           output_units=output_units, topic=topic, no_unit_check=no_unit_check,
                           accel_units=accel_units, accel_sensitivity=accel_sensitivity, gravity=gravity, imu=imu)
     report = characterise_recording(rec, motion=motion, source={"file": recording.name})

@@ -16,6 +16,7 @@ from ..choices import DeviceWire, Protocol, TimeStamps
 from ..errors import InputError
 from ._options import NoiseDensity, given, noise_std, numbers, refuse_unused, triple
 from ._outputs import check_output, json_format, starts_with
+from ._sim_output import announce, output_unit, rate_flags, write_output
 from ._sim_runs import multi_position, profile_run, turntable, turntable_protocol
 from .app import app, console
 
@@ -50,7 +51,9 @@ def simulate(
     output: Annotated[Path | None, typer.Option(
         "-o", "--output", help="Recording to write (CSV); the truth goes to *.truth.json (required, except with --device).")] = None,
     protocol: Annotated[Protocol, typer.Option("--protocol", help="Motion source.")] = "servo",
-    speed: Annotated[float, typer.Option("--speed", help="Servo/hand turn speed [deg/s].")] = 60.0,
+    speed: Annotated[Optional[str], typer.Option(
+        "--speed", help="Servo/hand turn speed, deg/s unless a unit is written, e.g. 1.05rad/s (default: 60 deg/s)."
+    )] = None,
     turns: Annotated[str, typer.Option("--turns", help="Turns, comma-separated.")] = "+x,-x,+y,-y,+z,-z",
     wait: Annotated[float, typer.Option("--wait", help="Static wait between turns [s].")] = 3.0,
     ramp: Annotated[float, typer.Option("--ramp", help="Acceleration ramp of each turn [s].")] = 0.3,
@@ -59,13 +62,20 @@ def simulate(
     k: Annotated[Optional[str], typer.Option(
         "--k", help="True scale factors kx,ky,kz (the servo method of Wang et al., eq. 1) (default: 1,1,1).")] = None,
     b: Annotated[Optional[str], typer.Option(
-        "--b", help="True biases bx,by,bz [rad/s] (the servo method of Wang et al., eq. 1) (default: 0,0,0).")] = None,
-    noise: Annotated[Optional[float], typer.Option("--noise", help="Per-sample white noise [rad/s] (default: 0.035, the paper's; 0.005 for the turntable).")] = None,
+        "--b", help="True biases bx,by,bz (the servo method of Wang et al., eq. 1), rad/s unless a unit is written "
+                    "after them, e.g. 0.5,-0.2,0.1deg/s (default: 0,0,0).")] = None,
+    noise: Annotated[Optional[str], typer.Option(
+        "--noise", help="Per-sample white noise, rad/s unless a unit is written, e.g. 2deg/s (default: 0.035 rad/s, "
+                        "the paper's; 0.005 rad/s for the turntable and static).")] = None,
     noise_density: NoiseDensity = None,
-    bias_instability: Annotated[float, typer.Option("--bias-instability", help="Gauss-Markov bias std [rad/s].")] = 0.0,
-    rate_random_walk: Annotated[float, typer.Option("--rrw", help="Rate random walk [rad/s/sqrt(s)].")] = 0.0,
-    quantum: Annotated[Optional[float], typer.Option("--quantum", help="Output resolution [rad/s] (default: none, not quantised).")] = None,
-    full_scale: Annotated[Optional[float], typer.Option("--full-scale", help="Saturation [deg/s] (default: none, never saturates).")] = None,
+    bias_instability: Annotated[Optional[str], typer.Option(
+        "--bias-instability", help="Gauss-Markov bias std, rad/s unless a unit is written (default: 0).")] = None,
+    rate_random_walk: Annotated[Optional[str], typer.Option(
+        "--rrw", help="Rate random walk per sqrt(s), rad/s/sqrt(s) unless deg/s is written (default: 0).")] = None,
+    quantum: Annotated[Optional[str], typer.Option(
+        "--quantum", help="Output resolution, rad/s unless a unit is written (default: none, not quantised).")] = None,
+    full_scale: Annotated[Optional[str], typer.Option(
+        "--full-scale", help="Saturation, deg/s unless a unit is written (default: none, never saturates).")] = None,
     poses: Annotated[int, typer.Option(
         "--poses", help="--protocol multi-position: still poses of the hand session.")] = 24,
     tilt: Annotated[float, typer.Option(
@@ -123,7 +133,12 @@ def simulate(
     gaps: Annotated[int, typer.Option("--gaps", help="Packet gaps: runs of samples never delivered.")] = 0,
     gap_length: Annotated[float, typer.Option("--gap-length", help="Length of each gap [s].")] = 0.17,
     sample_rate: Annotated[float, typer.Option("--sample-rate", help="Sampling rate [Hz].")] = 200.0,
-    units: Annotated[str, typer.Option("--units", help="Unit of the written gyro columns.")] = "deg/s",
+    units: Annotated[str, typer.Option(
+        "--units", help="Unit of the written gyro columns: deg/s, rad/s, or counts with --sensitivity.",
+        metavar="<deg/s|rad/s|counts>")] = "deg/s",
+    sensitivity: Annotated[Optional[float], typer.Option(
+        "--sensitivity", help="--units counts: LSB per deg/s of the written integers, e.g. 131 for an MPU-9250 at "
+                              "+-250 deg/s (required there; add --full-scale to clip at the sensor's range).")] = None,
     seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
     reference: Annotated[Optional[Path], typer.Option(
         "--reference", help="Also write the log of a reference gyro on the same motion (its own clock, mount, rate "
@@ -163,25 +178,26 @@ def simulate(
     from ..units import parse_rate_unit
 
     refuse_unused(ctx, _PROTOCOL_FLAGS, protocol, "--protocol")
+    speed, noise, bias_instability, rate_random_walk, quantum, full_scale, b = rate_flags(
+        speed, noise, bias_instability, rate_random_walk, quantum, full_scale, b)
     _refuse_reference_flags(ctx, reference)
     if device and reference is not None:
         raise InputError("--reference writes a second log; it does not go with --device (leave one out)")
     if device:
         return _serve_device(protocol, speed, turns, wait, misalignment, k, b, noise, noise_density, sample_rate,
                              seed, wire, faults, pace)
-    for name in ("wire", "faults", "pace"):
-        if given(ctx, name):
-            raise InputError(f"--{name} is for --device only; add --device or leave --{name} out")
+    _refuse_device_flags(ctx)
     truth_file = _check_outputs(output, truth_path(output) if output else None, reference, profile, force)
-    unit = parse_rate_unit(units)
+    unit = output_unit(units, sensitivity)
     rng = np.random.default_rng(seed)
     sd = noise_std(noise, noise_density, sample_rate, 0.035 if protocol not in ("turntable", "static") else 0.005)
-    model = ScaleBias(triple("--k", k, (1.0, 1.0, 1.0)), triple("--b", b, (0.0, 0.0, 0.0)))
+    model = ScaleBias(triple("--k", k, (1.0, 1.0, 1.0)), b)
     gyro_kw = dict(noise_std=tuple(sd), bias_instability=bias_instability, rate_random_walk=rate_random_walk,
                    quantum=quantum, full_scale=None if full_scale is None else math.radians(full_scale))
     settings = {"sample_rate": sample_rate, "noise_std": sd.tolist(), "bias_instability": bias_instability,
                 "rate_random_walk": rate_random_walk, "quantum": quantum, "full_scale_deg_s": full_scale,
                 "seed": seed, "units": unit}
+    size = announce(protocol, ctx.params, sample_rate, temps, rates, step_duration, unit, console)
     if protocol in _SERVO:
         rec, facts, true_rates = _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misalignment,
                                         sample_rate, rng, settings, revolutions=revolutions, ripple=ripple,
@@ -203,8 +219,7 @@ def simulate(
                                                      noise=ref_noise)
     if stamps == "receive" or gaps or given(ctx, "late_per_minute"):
         rec, facts = _time_defects(rec, facts, settings, stamps, late_per_minute, gaps, gap_length, reference, rng)
-    write_recording(output, rec, units=unit,
-                    header_comment=f"{_SIMULATED} --protocol {protocol}; gyro in {unit}, t in s")
+    write_output(output, rec, unit, sensitivity, settings, f"{_SIMULATED} --protocol {protocol}", large=bool(size))
     if ref_rec is not None:
         ref_unit = parse_rate_unit(ref_units, "ref_units")
         write_recording(reference, ref_rec, units=ref_unit,
@@ -230,6 +245,13 @@ def _check_outputs(output: Path | None, truth_file: Path | None, reference: Path
         check_output(reference, flag="--reference", inputs=(profile, output, truth_file), force=force,
                      replaceable=starts_with(f"# {_SIMULATED}"))
     return truth_file
+
+
+def _refuse_device_flags(ctx: typer.Context) -> None:
+    """--wire, --faults and --pace describe a served device: refuse them without --device."""
+    for name in ("wire", "faults", "pace"):
+        if given(ctx, name):
+            raise InputError(f"--{name} is for --device only; add --device or leave --{name} out")
 
 
 def _refuse_reference_flags(ctx: typer.Context, reference: Path | None) -> None:
@@ -292,7 +314,7 @@ def _serve_device(protocol, speed, turns, wait, misalignment, k, b, noise, noise
     kw = dict(speed=math.radians(speed), wait=wait, misalignment_deg=misalignment, lead_in=3.0)
     proto = ServoProtocol.hand(turn_list, **kw) if protocol == "hand" else ServoProtocol(turns=turn_list, **kw)
     sd = noise_std(noise, noise_density, sample_rate, 0.01)
-    model = ScaleBias(triple("--k", k, (1.0, 1.0, 1.0)), triple("--b", b, (0.0, 0.0, 0.0)))
+    model = ScaleBias(triple("--k", k, (1.0, 1.0, 1.0)), b)
     session = simulate_device_session(proto, model=model, noise_std=sd, rng=np.random.default_rng(seed),
                                       sample_rate=sample_rate)
     data, _ = damage(device_bytes(session, wire), fault)
@@ -358,3 +380,4 @@ def _static(gyro_kw, flags: dict, sample_rate, rng, settings):
                            "noise_density": accel.noise_density, "random_walk": accel.random_walk,
                            "gravity": [0.0, 0.0, 9.80665]}}}
     return rec, facts
+

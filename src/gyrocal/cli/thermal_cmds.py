@@ -53,11 +53,11 @@ def _full_scale(value: float | None, units: str, rate_unit: str, sensitivity: fl
     return value * unit_factor(units)
 
 
-def _read(path: Path, units: str, columns, sample_rate, sensitivity, output_units):
+def _read(path: Path, units: str, columns, sample_rate, sensitivity, output_units, skip_rows=None):
     from ..io import read_session
 
     return read_session(path, units=units, columns=columns, sample_rate=sample_rate, sensitivity=sensitivity,
-                        output_units=output_units, saturation="ignore")
+                        output_units=output_units, saturation="ignore", skip_rows=skip_rows)
 
 
 @app.command("thermal")
@@ -67,6 +67,7 @@ def thermal(
     output: Annotated[Path, typer.Option("-o", "--output", help="Thermal calibration file to write (JSON).")],
     output_units: READING.OutputUnits = None,
     columns: READING.Columns = None,
+    skip_rows: READING.SkipRows = None,
     sample_rate: READING.SampleRate = None,
     sensitivity: READING.Sensitivity = None,
     settle: Settle = 2.0,
@@ -86,7 +87,7 @@ def thermal(
     in_u, out_u = _units(units, output_units, sensitivity)
     check_output(output, inputs=(session,), force=True)  # what needs no fit: fail fast, before fitting
     with warnings_as_lines():
-        recs, names = _read(session, units, columns, sample_rate, sensitivity, output_units)
+        recs, names = _read(session, units, columns, sample_rate, sensitivity, output_units, skip_rows)
         cal, fit = calibrate_thermal(recs, input_units=in_u, output_units=out_u, settle=settle,
                                      full_scale=_full_scale(full_scale, units, out_u, sensitivity),
                                      temp_tolerance=temp_tolerance, reference_temp=ref_temp, max_order=max_order,
@@ -138,6 +139,7 @@ def thermal_report(
     units: Annotated[Optional[str], typer.Option("--units", help="Unit of the test data (default: the calibration's input unit).",
                                                           metavar="<rad/s|deg/s|counts>")] = None,
     columns: READING.Columns = None,
+    skip_rows: READING.SkipRows = None,
     sample_rate: READING.SampleRate = None,
     sensitivity: READING.Sensitivity = None,
     settle: Settle = 2.0,
@@ -158,7 +160,8 @@ def thermal_report(
     cal = load_thermal(calibration)
     units = units or cal.input_units
     with warnings_as_lines():
-        recs, _ = _read(test, units, columns, sample_rate, sensitivity, cal.output_units if units == "counts" else None)
+        recs, _ = _read(test, units, columns, sample_rate, sensitivity, cal.output_units if units == "counts" else None,
+                        skip_rows)
         ev = evaluate(cal, recs, settle=settle, temp_tolerance=temp_tolerance, out_of_range=out_of_range,
                       full_scale=_full_scale(full_scale, units, cal.output_units, sensitivity))
         paths = write_report(cal, ev, output, figures=figures)
@@ -167,7 +170,7 @@ def thermal_report(
 
     table = Table(title=escape(f"RMS error [{cal.output_units}] per rotating axis / gyro axis"))
     for col in ("rot", "gyro", "uncomp.", "traditional", "lagrange", "smooth", "lagrange cut"):
-        table.add_column(col, justify="right")
+        table.add_column(col, justify="right", no_wrap=True)
     for r in ev.summary(cal.output_units):
         table.add_row(r["rotating_axis"], r["gyro_axis"], *(f"{r[m + '_rms']:.4g}" for m in
                       ("uncompensated", "traditional", "lagrange", "smooth")), f"{r['lagrange_rms_reduction_pct']:.1f} %")

@@ -25,7 +25,7 @@ from ..units import parse_rate_unit
 from .filedoc import accelerometer_section, gyro_fit_section
 from .session import ImuCalibrationResult, calibrate_imu
 
-__all__ = ["ImuRun", "accel_scale", "calibrate_recording"]
+__all__ = ["ImuRun", "accel_scale", "calibrate_recording", "plausibility"]
 
 ACCEL_OUTPUT_UNITS = ("m/s^2", "g")
 #: A gap of at most this many lost samples is integrated across (its trapezoid error is third order in
@@ -49,6 +49,33 @@ class ImuRun:
     result: ImuCalibrationResult
     calibration: Calibration
     time_base: TimeBase
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        """The fits' warnings, and scale factors far from 1 in physical units (a declared unit that is wrong)."""
+        return self.result.warnings + plausibility(self.calibration)
+
+
+#: Scale factors in physical units further than this from 1 point to a declared unit that is wrong.
+SCALE_PLAUSIBLE = 0.2
+
+
+def plausibility(cal: Calibration) -> tuple[str, ...]:
+    """Warnings for scale factors far from 1 when both ends are physical units (a wrong --units or --accel-units)."""
+    out = []
+    if cal.input_units != "counts":
+        k = np.abs(np.diag(cal.correction[0]))
+        if np.any(np.abs(k - 1) > SCALE_PLAUSIBLE):
+            out.append(f"the gyro's scale factors are {', '.join(f'{v:.4g}' for v in k)} {cal.output_units} per "
+                       f"{cal.input_units}, far from 1: is the gyro's unit right? (57.3: deg/s read as rad/s)")
+    part = cal.accelerometer
+    if part is not None and part["units"]["input"] != "counts":
+        units = part["units"]
+        k = np.abs(np.diag(np.asarray(part["parameters"]["matrix"], dtype=float)))  # m/s^2 per m/s^2 as read
+        if np.any(np.abs(k - 1) > SCALE_PLAUSIBLE):
+            out.append(f"the accelerometer's scale factors are {', '.join(f'{v:.4g}' for v in k)}, far from 1: is "
+                       f"--accel-units {units['input']} right? (9.8: g read as m/s^2)")
+    return tuple(out)
 
 
 def accel_scale(units: str, sensitivity: float | None, gravity: float) -> float:

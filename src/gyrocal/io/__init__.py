@@ -7,6 +7,7 @@ extra) logs. Everything comes back as a checked
 """
 
 from ..saturation import find_saturation
+from .accel_log import attach_accelerometer
 from .flightlog import read_flight_log
 from .profile import read_profile
 from .reader import read_header_comment, read_recording
@@ -14,5 +15,5 @@ from .session import read_session
 from .windowsfile import read_windows
 from .writer import recording_columns, write_csv, write_recording
 
-__all__ = ["find_saturation", "read_flight_log", "read_header_comment", "read_profile", "read_recording", "read_session",
+__all__ = ["attach_accelerometer", "find_saturation", "read_flight_log", "read_header_comment", "read_profile", "read_recording", "read_session",
            "read_windows", "recording_columns", "write_csv", "write_recording"]

@@ -39,7 +39,7 @@ def _text(arr: np.ndarray) -> list[str]:
     return ["" if x is None else str(x) for x in arr.tolist()]
 
 
-def write_csv(path: str | os.PathLike, columns: dict, *, header_comment: str | None = None) -> None:
+def write_csv(path: str | os.PathLike, columns: dict, *, header_comment: str | None = None, progress=None) -> None:
     """Write columns to a comma-separated file, atomically, a chunk of rows at a time.
 
     Parameters
@@ -52,6 +52,8 @@ def write_csv(path: str | os.PathLike, columns: dict, *, header_comment: str | N
         other values as text (quoted only when a cell holds a comma, a quote or a newline).
     header_comment : str, optional
         Written first, each line prefixed with ``# ``; :func:`read_recording` skips it.
+    progress : callable, optional
+        Called with the number of rows written after each chunk (a progress bar).
     """
     arrays = _columns(columns)
     n = len(next(iter(arrays.values())))
@@ -63,6 +65,8 @@ def write_csv(path: str | os.PathLike, columns: dict, *, header_comment: str | N
         with open(tmp, "ab") as f:
             for start in range(0, n, CHUNK_ROWS):
                 write_chunk(f, {k: v[start:start + CHUNK_ROWS] for k, v in arrays.items()})
+                if progress is not None:
+                    progress(min(CHUNK_ROWS, n - start))
 
 
 def _comment(f, header_comment: str | None) -> None:
@@ -140,6 +144,7 @@ def recording_columns(rec, units: str | None = None) -> dict[str, np.ndarray]:
 
 
 def write_recording(path: str | os.PathLike, rec, *, units: str | None = None,
-                    header_comment: str | None = None) -> None:
-    """Write a recording as CSV (:func:`recording_columns`), atomically, with an optional ``#`` comment."""
-    write_csv(path, recording_columns(rec, units), header_comment=header_comment)
+                    header_comment: str | None = None, progress=None) -> None:
+    """Write a recording as CSV (:func:`recording_columns`), atomically, with an optional ``#`` comment
+    (`progress` as for :func:`write_csv`)."""
+    write_csv(path, recording_columns(rec, units), header_comment=header_comment, progress=progress)
