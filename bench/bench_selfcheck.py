@@ -13,7 +13,7 @@ optionally with receive-time stamps, then times in the same process, alternating
   stamps (rate, gaps, late deliveries, the sensor clock rebuilt), turns across gaps screened,
   goodness of fit with Birge scaling, plausibility of k, the ``fit`` and ``observed`` sections;
 * the plain estimate, ``checks=False, long_run=False``: white-noise covariance, plain means, as
-  before issue 10 (to show the cost of everything together).
+  before the self-checks existed (to show the cost of everything together).
 
 Prints the best CPU time of `repeat` runs of each, for the speed and the angle reference, and what
 the checks add, against the calibration alone and against reading the CSV plus calibrating (what
@@ -86,8 +86,8 @@ def main() -> None:
         extra = checked - estimate
         print(f"{name} ({len(run.observations)} windows): calibrate {estimate:.3f} s without the self-checks, "
               f"{checked:.3f} s with them: the self-checks cost {100 * extra / estimate:.1f} % of the calibration "
-              f"(target < 10 %), {100 * extra / (estimate + read):.1f} % of reading + calibrating. Everything this "
-              f"issue added (self-checks, ripple and long-run variances: {checked:.3f} s against the plain "
+              f"(target < 10 %), {100 * extra / (estimate + read):.1f} % of reading + calibrating. Everything added "
+              f"to the plain estimate (self-checks, ripple and long-run variances: {checked:.3f} s against the plain "
               f"estimate's {plain:.3f} s): {100 * (checked / plain - 1):.1f} % of the calibration, "
               f"{100 * (checked - plain) / (plain + read):.1f} % of reading + calibrating")
 
