@@ -352,7 +352,7 @@ def _spread_blocks(gyro: np.ndarray, sample_rate: float, most: int = 200) -> np.
     if blocks <= most:
         return gyro
     pick = np.linspace(0, blocks - 1, most).astype(np.intp)
-    return gyro[(pick[:, None] * size + np.arange(size)).ravel()]
+    return gyro[: blocks * size].reshape(blocks, size, gyro.shape[1])[pick].reshape(-1, gyro.shape[1])
 
 
 def _single_turns(windows: Sequence[Window], reference: str, declared: float) -> list[str]:
