@@ -68,8 +68,8 @@ def _stretch(x: np.ndarray, t: np.ndarray | None, starts: np.ndarray, stops: np.
     w = None if t is None else _weights(t, starts, stops - 1)
     duration = count if w is None else np.add.reduceat(w, bounds)[::2]
     total, total_sq, noise = (np.empty((len(starts), x.shape[1])) for _ in range(3))
-    for j in range(x.shape[1]):
-        c = np.ascontiguousarray(x[:, j])
+    columns = np.ascontiguousarray(x.T)  # no copy for column-major readings (as read); one pass for others
+    for j, c in enumerate(columns):
         square = c * c
         if w is not None:
             square *= w

@@ -173,13 +173,14 @@ def _reference(kind: str, speed, angle, duration: float) -> tuple[float, float]:
 
 
 def observe_many(x: np.ndarray, starts, stops, sample_rate: float, kinds: Sequence[ReferenceKind], *,
-                 speed: float | None = None, angles=None, t: np.ndarray | None = None, levels=None,
-                 mean_vars=None) -> tuple[Observation, ...]:
+                 speed: float | None = None, angles=None, t: np.ndarray | None = None, period: float | None = None,
+                 levels=None, mean_vars=None) -> tuple[Observation, ...]:
     """:func:`observe` for windows ``starts[i]:stops[i]`` of one recording `x` (N, 3), reduced together.
 
     `x` (and `t`, strictly increasing) are taken as checked, as a :class:`~gyrocal.recording.Recording`'s
     are; `kinds`, `angles`, `levels` and `mean_vars` hold one entry per window (None where :func:`observe`
-    takes its default). The reductions are :func:`gyrocal.moments.window_moments`'s.
+    takes its default). Without `t`, a window lasts ``count x period`` [s] (default ``1 / sample_rate``).
+    The reductions are :func:`gyrocal.moments.window_moments`'s.
     """
     fs = positive("sample_rate", sample_rate)
     n = len(kinds)
@@ -188,7 +189,8 @@ def observe_many(x: np.ndarray, starts, stops, sample_rate: float, kinds: Sequen
     counts = np.asarray(stops) - np.asarray(starts)
     out = []
     for i, kind in enumerate(kinds):
-        duration = int(counts[i]) / fs if t is None else float(moments.duration[i])
+        duration = (int(counts[i]) / fs if period is None else int(counts[i]) * period) if t is None \
+            else float(moments.duration[i])
         rate, ang = _reference(kind, speed, angles[i], duration)
         out.append(Observation(mean=moments.mean[i] if levels[i] is None else levels[i], mean_var=mean_vars[i],
                                mean_sq=moments.mean_sq[i], noise_var=moments.noise_var[i], count=int(counts[i]),

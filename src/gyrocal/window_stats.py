@@ -52,7 +52,7 @@ def _pooled_lrv(residuals: list, sizes: list[int]) -> np.ndarray:
 
 def observe_windows(rec: Recording, windows: Sequence[Window], reference: str, speed: float | None, *,
                     long_run: bool = True, ripple: bool = True,
-                    times: np.ndarray | None = None) -> tuple[Observation, ...]:
+                    times: np.ndarray | None = None, period: float | None = None) -> tuple[Observation, ...]:
     """Reduce every window of `rec` for the `reference` (``"speed"`` or ``"angle"``).
 
     Parameters
@@ -69,22 +69,27 @@ def observe_windows(rec: Recording, windows: Sequence[Window], reference: str, s
         mean of squares needs the plain mean).
     times : ndarray, shape (N,), optional
         Sample times [s] to integrate on; default the recording's stamps. The pipeline passes the
-        regular sensor clock rebuilt from them (:meth:`gyrocal.timebase.TimeBase.clock_times`).
+        regular sensor clock rebuilt from them when it has gaps (:meth:`gyrocal.timebase.TimeBase.clock_times`).
+    period : float, optional
+        The period [s] of a regular clock without gaps that the samples lie on (the pipeline knows it from
+        the time base, :attr:`gyrocal.timebase.TimeBase.clock_period`): the trapezoid weights on such a
+        clock are even, so the windows are weighted evenly and last ``count x period``; `times` is unused.
     """
-    times = rec.t if times is None else times
+    times = None if period is not None else rec.t if times is None else times
     stats: dict[int, dict] = {}
     if long_run or ripple:
         stats = _window_stats(rec, windows, reference, times, long_run=long_run, ripple=ripple)
     kinds = ["static" if w.kind == "static" else reference for w in windows]
     return observe_many(rec.gyro, [w.start for w in windows], [w.stop for w in windows], rec.sample_rate, kinds,
                         speed=speed, angles=[w.angle if k == "angle" else None for w, k in zip(windows, kinds)],
-                        t=times, levels=[stats.get(i, {}).get("level") for i in range(len(windows))],
+                        t=times, period=period, levels=[stats.get(i, {}).get("level") for i in range(len(windows))],
                         mean_vars=[stats.get(i, {}).get("mean_var") for i in range(len(windows))])
 
 
-def _window_stats(rec: Recording, windows: Sequence[Window], reference: str, times: np.ndarray, *,
+def _window_stats(rec: Recording, windows: Sequence[Window], reference: str, times: np.ndarray | None, *,
                   long_run: bool, ripple: bool) -> dict[int, dict]:
-    """``{window index: {"level": ..., "mean_var": ...}}`` for the plateaus and static windows."""
+    """``{window index: {"level": ..., "mean_var": ...}}`` for the plateaus and static windows (`times`
+    None: on a regular clock)."""
     d = max(1, int(round(rec.sample_rate / _STATS_RATE)))
     gyro = block_means(rec.gyro, d)  # one pass over the recording; windows take the blocks inside them
     span = {i: (-(-w.start // d), w.stop // d) for i, w in enumerate(windows)}
@@ -101,18 +106,21 @@ def _window_stats(rec: Recording, windows: Sequence[Window], reference: str, tim
     return out
 
 
-def _plateau_stats(blocks: dict, span: dict, plateaus: list[int], times: np.ndarray, d: int, *,
+def _plateau_stats(blocks: dict, span: dict, plateaus: list[int], times: np.ndarray | None, d: int, *,
                    long_run: bool, ripple: bool) -> dict[int, dict]:
     """Levels (ripple regressed out) and mean variances of the plateaus, block means of `d` samples."""
     lines: list[float] = []
     if ripple:
         b = blocks[max(plateaus, key=lambda i: len(blocks[i]))]
         lines = find_lines(b[:, int(np.argmax(np.abs(b.mean(axis=0))))])
-    clock = block_means(np.asarray(times, dtype=float), d)
-    ts = []
-    for i in plateaus:
-        t = clock[span[i][0]:span[i][1]]
-        ts.append((t - t[0]) / ((t[-1] - t[0]) / (len(t) - 1)))  # block centres on the sample clock, in block steps
+    if times is None:  # a regular clock: the block centres are whole block steps apart
+        ts = [np.arange(len(blocks[i]), dtype=float) for i in plateaus]
+    else:
+        clock = block_means(np.asarray(times, dtype=float), d)
+        ts = []
+        for i in plateaus:
+            t = clock[span[i][0]:span[i][1]]
+            ts.append((t - t[0]) / ((t[-1] - t[0]) / (len(t) - 1)))  # block centres on the sample clock, in block steps
     fits = dict(zip(plateaus, fit_levels([blocks[i] for i in plateaus], ts, lines)))
     out: dict[int, dict] = {i: {"level": fits[i][0]} for i in plateaus} if ripple else {}
     if long_run:
