@@ -179,13 +179,13 @@ def _floors(r: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _residual_floors(t: np.ndarray, period: float, size: int, lost=None) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`_floors` of the clock residual (less the samples `lost` up to each sample, a function of
-    the sample numbers), computed a cache-sized stretch of whole blocks at a time."""
+    """:func:`_floors` of the clock residual (less the samples `lost` up to each sample: a function of
+    ``lo, hi`` giving them for samples ``lo:hi``), computed a cache-sized stretch of whole blocks at a time."""
     stretch = size * max(1, _STRETCH // size)
 
     def stretch_of(lo: int, hi: int) -> np.ndarray:
         r = residual(t, period, lo, hi)
-        return r if lost is None else r - period * lost(np.arange(lo, hi))
+        return r if lost is None else r - period * lost(lo, hi)
 
     parts = [_floors(stretch_of(lo, min(lo + stretch, len(t))), size) for lo in range(0, len(t), stretch)]
     return (np.concatenate([v for v, _ in parts]),
@@ -243,7 +243,7 @@ def analyse_time(t, *, has_time: bool = True) -> TimeBase:
         gaps = found.gaps
         k = None
         if gaps:  # the envelope again, with the lost samples counted (a block may straddle a gap)
-            floor, at = _residual_floors(t, period, size, found.upto)
+            floor, at = _residual_floors(t, period, size, found.upto_range)
             k = at + found.upto(at)
         clock = _fit_clock(t, period, floor, at if k is None else k)
         if gaps:

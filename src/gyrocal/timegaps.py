@@ -87,6 +87,12 @@ class Found:
             return np.zeros(np.shape(at))
         return self._total[np.searchsorted(self._index, at, side="right")]
 
+    def upto_range(self, lo: int, hi: int) -> np.ndarray:
+        """:meth:`upto` of the sample numbers ``lo:hi``, a step function laid out by its steps."""
+        first, last = np.searchsorted(self._index, [lo, hi - 1], side="right")
+        edges = np.concatenate(([lo], self._index[first:last], [hi]))
+        return np.repeat(self._total[first:last + 1], np.diff(edges))
+
 
 def _window_floors(t: np.ndarray, period: float, found: Found, i: np.ndarray, base: np.ndarray,
                    size: int) -> tuple[np.ndarray, np.ndarray]:
@@ -103,7 +109,7 @@ def _window_floors(t: np.ndarray, period: float, found: Found, i: np.ndarray, ba
     cut = np.flatnonzero((np.diff(base[order]) != 0) | (np.diff(i[order]) > 2 * size)) + 1
     for part in np.split(order, cut):
         a, b = int(i[part[0]]) - size + 1, int(i[part[-1]]) + 1 + size
-        stretch = residual(t, period, a, b) - period * (found.upto(np.arange(a, b)) - base[part[0]])
+        stretch = residual(t, period, a, b) - period * (found.upto_range(a, b) - base[part[0]])
         first, second = i[part] - size + 1 - a, i[part] + 1 - a  # where each window starts in the stretch
         if b - a < 50 * len(part):  # dense: one pass of the filter over the stretch
             from scipy.ndimage import rank_filter
@@ -129,7 +135,7 @@ def _judge(t: np.ndarray, period: float, found: Found, steps: np.ndarray, size: 
     for j in np.flatnonzero(~inner):
         i = int(steps[j])
         lo, hi = max(0, i - size + 1), min(n, i + 1 + size)
-        adj = residual(t, period, lo, hi) - period * (found.upto(np.arange(lo, hi)) - (found.upto(lo - 1) if lo else 0.0))
+        adj = residual(t, period, lo, hi) - period * (found.upto_range(lo, hi) - (found.upto(lo - 1) if lo else 0.0))
         before = least_delayed(adj[: i + 1 - lo])
         gone = int(np.rint((least_delayed(adj[i + 1 - lo:]) - before) / period))
         # the step from a late sample is short by that sample's delay: count it in the room
