@@ -136,6 +136,8 @@ class _Guided:
         self.sensitivity = sens
         accel = self.accel_sensitivity or (hello.accel_sensitivity if hello else None)
         start = max(self.guide.keep_from, store.first)
+        if len(store) - start < 2:  # just after a redo: nothing new to judge yet
+            return False
         rec = store.recording(self.units, sens, self.sample_rate, start=start, accel_sensitivity=accel)
         self._events(self.guide.update(rec, offset=start))
         return self.guide.complete
