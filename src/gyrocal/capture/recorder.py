@@ -249,8 +249,8 @@ class Capture:
                     self.on_event("progress", self)
         finally:
             ser.close()
-            if self._text is not None:
-                self._text.finish()
+            if self._text is not None and r.ended in ("", "end of stream"):  # a line cut by the link is bad; one
+                self._text.finish()                                          # left unread on purpose is not
             r.ended = r.ended or "stopped"
             r.stats = self.link_stats()
             r.device.settle()
