@@ -219,6 +219,8 @@ def test_simulate_device_serves_capture(tmp_path):
 def test_simulate_device_flags_need_device(tmp_path):
     assert "--device" in refused("simulate", "-o", tmp_path / "r.csv", "--faults", "drop=0.1")
     assert "not understood" in refused("simulate", "--device", "--faults", "melt=1")
+    assert "guide's poses" in refused("simulate", "--device", "--protocol", "multi-position", "--tilt", "45")
+    assert "--device serves servo, hand or multi-position" in refused("simulate", "--device", "--protocol", "static")
 
 
 def test_capture_warns_when_the_device_result_is_off(tmp_path, servo):
