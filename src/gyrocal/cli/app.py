@@ -7,6 +7,7 @@ and exit code 2; ``--debug`` shows the traceback instead.
 from __future__ import annotations
 
 import contextlib
+import functools
 import os
 import sys
 import warnings
@@ -169,6 +170,13 @@ def message(exc: BaseException) -> str:
     return f"{getattr(exc, 'strerror', None) or exc}: {getattr(exc, 'filename', None) or ''}".strip(": ")
 
 
+@functools.cache
+def _click_command():
+    """The click command typer builds from :data:`app` (every command registers at import): built once, as
+    typer would rebuild it for every run in the same process (tests run hundreds)."""
+    return typer.main.get_command(app)
+
+
 def run(argv: list[str] | None = None) -> int:
     """Run the CLI; map library, OS and usage errors to one line and exit code 2."""
     if argv is not None and not argv:
@@ -177,7 +185,7 @@ def run(argv: list[str] | None = None) -> int:
         with warnings.catch_warnings():
             warnings.simplefilter("always", GyrocalWarning)
             warnings.showwarning = _show_warning
-            rv = app(args=argv, prog_name="gyrocal", standalone_mode=False)
+            rv = _click_command()(args=argv, prog_name="gyrocal", standalone_mode=False)
     except (GyrocalError, OSError) as exc:
         if _state["debug"]:
             raise
