@@ -474,3 +474,12 @@ def test_c_and_python_share_the_range_margin():
     header = (firmware.c_source_dir() / "gyrocal_cal.h").read_text()
     margin = re.search(r"#define GYROCAL_THERMAL_MARGIN ([0-9.]+)f", header)
     assert margin is not None and float(margin.group(1)) == RANGE_MARGIN
+
+
+def test_c_and_python_unpack_kg_the_same_way():
+    """The C library's KG_SLOT (gyrocal_cal.c) against gyrocal.models.KG_INDEX: Kg element e sits at
+    row * 3 + column of K in both."""
+    source = (firmware.c_source_dir() / "gyrocal_cal.c").read_text()
+    slots = re.search(r"KG_SLOT\[9\]\s*=\s*\{([^}]*)\}", source)
+    assert slots is not None
+    assert [int(v) for v in slots.group(1).split(",")] == [3 * r + c for r, c in KG_INDEX]

@@ -23,8 +23,9 @@ import numpy as np
 from ._arrays import readonly
 from ._validation import finite_array, positive
 from .errors import InputError
+from .moments import window_moments
 
-__all__ = ["Observation", "ObservationSet", "ReferenceKind", "observe"]
+__all__ = ["Observation", "ObservationSet", "ReferenceKind", "observe", "observe_many"]
 
 ReferenceKind = Literal["speed", "angle", "static"]
 _KINDS = ("speed", "angle", "static")
@@ -77,8 +78,7 @@ class Observation:
         if not (math.isfinite(self.rate_var) and self.rate_var >= 0):
             raise InputError(f"rate_var must be finite and >= 0, got {self.rate_var!r}")
         for name in ("mean", "mean_sq", "noise_var") + (("mean_var",) if self.mean_var is not None else ()):
-            arr = finite_array(name, getattr(self, name), shape_tail=(3,), ndim=1)
-            object.__setattr__(self, name, readonly(arr, copy=True))
+            object.__setattr__(self, name, _vector3(name, getattr(self, name)))
         if self.kind not in _KINDS:
             raise InputError(f"kind={self.kind!r} is not one of {_KINDS}")
         if int(self.count) < 2:
@@ -90,6 +90,18 @@ class Observation:
             positive("rate", self.rate)
 
 
+def _vector3(name: str, value) -> np.ndarray:
+    """A read-only copy of a finite 3-vector; anything else goes through :func:`finite_array` for its message.
+
+    Windows are reduced by the thousand: the plain case is checked in a few operations.
+    """
+    arr = value.astype(float) if isinstance(value, np.ndarray) and value.dtype.kind in "fiu" else None
+    if arr is None or arr.shape != (3,) or not (math.isfinite(arr[0]) and math.isfinite(arr[1])
+                                                 and math.isfinite(arr[2])):
+        arr = np.array(finite_array(name, value, shape_tail=(3,), ndim=1))
+    return readonly(arr, copy=False)
+
+
 def _magnitude(name: str, value) -> float:
     """|value|, refusing zero and non-numbers: a turn's sense does not matter to the norm equations."""
     try:
@@ -97,19 +109,6 @@ def _magnitude(name: str, value) -> float:
     except (TypeError, ValueError):
         raise InputError(f"{name} must be a non-zero number, got {value!r}") from None
     return positive(name, magnitude)
-
-
-def _time_weights(t: np.ndarray, n: int) -> np.ndarray:
-    """Time each sample stands for [s]: half of each neighbouring step (the whole step at the ends)."""
-    if t.shape != (n,):
-        raise InputError(f"t has {len(t)} sample times but the window has {n} samples")
-    step = np.diff(t)
-    if np.any(step <= 0):
-        raise InputError("t must increase strictly inside a window")
-    w = np.empty(n)
-    w[0], w[-1] = step[0], step[-1]
-    w[1:-1] = (step[:-1] + step[1:]) / 2
-    return w
 
 
 def observe(
@@ -149,37 +148,54 @@ def observe(
         Variance of that level, measured on the data [reading units^2] (see :class:`Observation`).
     """
     m = finite_array("samples", samples, shape_tail=(3,), ndim=2)
-    fs = positive("sample_rate", sample_rate)
     if len(m) < 2:
         raise InputError(f"a window needs at least 2 samples, got {len(m)}")
-    if t is None:
-        weights, duration = None, len(m) / fs
-    else:
-        weights = _time_weights(finite_array("t", t, ndim=1), len(m))
-        duration = float(weights.sum())
+    if t is not None:
+        t = finite_array("t", t, ndim=1)
+        if t.shape != (len(m),):
+            raise InputError(f"t has {len(t)} sample times but the window has {len(m)} samples")
+    return observe_many(m, [0], [len(m)], sample_rate, [kind], speed=speed, angles=[angle], t=t,
+                        levels=[level], mean_vars=[mean_var])[0]
+
+
+def _reference(kind: str, speed, angle, duration: float) -> tuple[float, float]:
+    """``(rate, angle)`` of a window of `kind` lasting `duration` [s]."""
     if kind == "speed":
         if speed is None:
             raise InputError("kind='speed' needs speed [rad/s]")
-        rate, ang = _magnitude("speed", speed), math.nan
-    elif kind == "angle":
+        return _magnitude("speed", speed), math.nan
+    if kind == "angle":
         ang = 2 * math.pi if angle is None else _magnitude("angle", angle)
-        rate = ang / duration
-    elif kind == "static":
-        rate, ang = 0.0, math.nan
-    else:
-        raise InputError(f"kind={kind!r} is not one of {_KINDS}")
-    d = np.diff(m, axis=0)
-    return Observation(
-        mean=np.average(m, axis=0, weights=weights) if level is None else level,
-        mean_var=mean_var,
-        mean_sq=np.average(m * m, axis=0, weights=weights),
-        noise_var=(d * d).mean(axis=0) / 2.0,
-        count=len(m),
-        duration=duration,
-        kind=kind,
-        rate=rate,
-        angle=ang,
-    )
+        return ang / duration, ang
+    if kind == "static":
+        return 0.0, math.nan
+    raise InputError(f"kind={kind!r} is not one of {_KINDS}")
+
+
+def observe_many(x: np.ndarray, starts, stops, sample_rate: float, kinds: Sequence[ReferenceKind], *,
+                 speed: float | None = None, angles=None, t: np.ndarray | None = None, period: float | None = None,
+                 levels=None, mean_vars=None) -> tuple[Observation, ...]:
+    """:func:`observe` for windows ``starts[i]:stops[i]`` of one recording `x` (N, 3), reduced together.
+
+    `x` (and `t`, strictly increasing) are taken as checked, as a :class:`~gyrocal.recording.Recording`'s
+    are; `kinds`, `angles`, `levels` and `mean_vars` hold one entry per window (None where :func:`observe`
+    takes its default). Without `t`, a window lasts ``count x period`` [s] (default ``1 / sample_rate``).
+    The reductions are :func:`gyrocal.moments.window_moments`'s.
+    """
+    fs = positive("sample_rate", sample_rate)
+    n = len(kinds)
+    angles, levels, mean_vars = ([None] * n if v is None else v for v in (angles, levels, mean_vars))
+    moments = window_moments(x, starts, stops, t)
+    counts = np.asarray(stops) - np.asarray(starts)
+    out = []
+    for i, kind in enumerate(kinds):
+        duration = (int(counts[i]) / fs if period is None else int(counts[i]) * period) if t is None \
+            else float(moments.duration[i])
+        rate, ang = _reference(kind, speed, angles[i], duration)
+        out.append(Observation(mean=moments.mean[i] if levels[i] is None else levels[i], mean_var=mean_vars[i],
+                               mean_sq=moments.mean_sq[i], noise_var=moments.noise_var[i], count=int(counts[i]),
+                               duration=duration, kind=kind, rate=rate, angle=ang))
+    return tuple(out)
 
 
 @dataclass(frozen=True)

@@ -279,8 +279,10 @@ def calibrate(
                              value if reference == "angle" else None)
     tb = rec.time_base() if checks else None
     angle_var: dict = {}
-    # the sensor's clock under receive-time stamps (stamps already on a regular clock are their own)
-    times = None if tb is None or (not tb.gaps and tb.jitter <= 1e-9 * tb.period) else tb.clock_times()
+    # the sensor's clock under receive-time stamps: without gaps its trapezoid weights are even (a window
+    # lasts count x period), so only a clock with gaps needs its sample times rebuilt
+    period = tb.clock_period if tb is not None and tb.regular_clock and not tb.gaps else None
+    times = tb.clock_times() if tb is not None and tb.gaps else None
     if tb is not None:
         seg, angle_var = screen_gaps(seg, rec, tb, reference, times)
     uses_static = method == "first-moment"
@@ -289,7 +291,7 @@ def calibrate(
     if checks and not uses_static:
         require_constant_rate(rec, used, seg.baseline, method)
     observations = observe_windows(rec, used, reference, value, long_run=long_run and uses_static and noise_std is None,
-                                   ripple=long_run and uses_static, times=times)
+                                   ripple=long_run and uses_static, times=times, period=period)
     if angle_var:  # turns across a time-stamp gap: their rate is known within the gap's bound
         observations = tuple(dataclasses.replace(o, rate_var=angle_var[(w.start, w.stop)] * o.rate**2)
                              if (w.start, w.stop) in angle_var else o for w, o in zip(used, observations))
@@ -352,7 +354,7 @@ def _spread_blocks(gyro: np.ndarray, sample_rate: float, most: int = 200) -> np.
     if blocks <= most:
         return gyro
     pick = np.linspace(0, blocks - 1, most).astype(np.intp)
-    return gyro[(pick[:, None] * size + np.arange(size)).ravel()]
+    return gyro[: blocks * size].reshape(blocks, size, gyro.shape[1])[pick].reshape(-1, gyro.shape[1])
 
 
 def _single_turns(windows: Sequence[Window], reference: str, declared: float) -> list[str]:

@@ -42,6 +42,10 @@ def _freeze(value: Any, where: str) -> Any:
             raise InputError(f"{where} must have text keys, got {list(value)!r}")
         return MappingProxyType({k: _freeze(v, f"{where}.{k}") for k, v in value.items()})
     if isinstance(value, (list, tuple)):
+        # plain numbers or text, the bulk of a long section (residuals of thousands of windows): as they are
+        if all(type(v) in (float, int) for v in value) and all(map(math.isfinite, value)) or \
+                all(type(v) is str for v in value):
+            return tuple(value)
         return tuple(_freeze(v, f"{where}[{i}]") for i, v in enumerate(value))
     raise InputError(f"{where} must be a JSON value (number, text, list, object or null), got {type(value).__name__}")
 

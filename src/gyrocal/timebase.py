@@ -24,16 +24,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import InputError
+from .timegaps import LATE_STEP as _LATE_STEP
+from .timegaps import Gap, find_gaps, residual
 
 __all__ = ["Gap", "TimeBase", "analyse_time", "nominal_period"]
 
 _BLOCK = 64  # steps per block of the robust period estimate
 _ENVELOPE = 50  # samples each side over which the clock residual's lower envelope is taken, at least
 _ENVELOPE_S = 0.5  # [s] and at least this long: a late packet's burst must drain inside it
-#: Steps below this multiple of the period cannot hide a lost sample and are not examined.
-_CANDIDATE_STEP = 1.5
-#: A step this many periods long that lost nothing is a late delivery (shorter ones are jitter).
-_LATE_STEP = 3.0
+_STRETCH = 1 << 16  # samples per pass over long logs: the temporaries stay in the cache
 
 
 def nominal_period(t: np.ndarray) -> float:
@@ -51,25 +50,6 @@ def nominal_period(t: np.ndarray) -> float:
         return float(t[-1] - t[0]) / n
     ends = t[::block]
     return float(np.median(np.diff(ends))) / block
-
-
-@dataclass(frozen=True)
-class Gap:
-    """Samples missing from a log: the step ``t[index - 1] -> t[index]`` lost `lost` samples.
-
-    Attributes
-    ----------
-    index : int
-        First sample after the gap.
-    step : float
-        The long step [s].
-    lost : int
-        Samples missing, from the jump of the regular clock.
-    """
-
-    index: int
-    step: float
-    lost: int
 
 
 @dataclass(frozen=True)
@@ -184,12 +164,6 @@ class TimeBase:
         return lines
 
 
-def _floor(x: np.ndarray) -> float:
-    """A low quantile (the tenth) of `x`: the least-delayed level, unmoved by one late sample."""
-    k = len(x) // 10
-    return float(np.partition(x, k)[k])
-
-
 def _block_size(period: float, n: int) -> int:
     """Samples over which the least-delayed level is taken: 50, and at least half a second."""
     return int(min(n, max(_ENVELOPE, round(_ENVELOPE_S / period))))
@@ -204,40 +178,39 @@ def _floors(r: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
     return r[at], at
 
 
-def _find_gaps(r: np.ndarray, step: np.ndarray, period: float, floor: np.ndarray, size: int) -> list[Gap]:
-    """Real gaps: long steps across which the lower envelope of the clock residual `r` rises for good.
+def _residual_floors(t: np.ndarray, period: float, size: int, lost=None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_floors` of the clock residual (less the samples `lost` up to each sample: a function of
+    ``lo, hi`` giving them for samples ``lo:hi``), computed a cache-sized stretch of whole blocks at a time."""
+    stretch = size * max(1, _STRETCH // size)
 
-    Blocks whose least-delayed level (`floor`, blocks of `size`) rises by half a period over the
-    block before hold the candidates. Each long step there is confirmed by the least-delayed level
-    (a low quantile, so that a few delayed samples at a gap's edge do not count) just before and
-    just after it, with the gaps already found taken out: the longest steps first, then the shorter
-    ones in time order, so that a burst's long step right after a real gap is judged with that gap
-    removed. A step must also be long enough to hold the samples it lost (counting the delay of
-    the sample before it, which shortens the step).
-    """
-    rise = np.flatnonzero(np.diff(floor) >= 0.5 * period)
-    if not len(rise):
-        return []
-    candidates = np.flatnonzero(step > _CANDIDATE_STEP * period)
-    lo = np.searchsorted(candidates, rise * size)
-    hi = np.searchsorted(candidates, (rise + 2) * size)
-    likely = np.unique(np.concatenate([candidates[a:b] for a, b in zip(lo, hi)]))
-    long_first = likely[step[likely] >= _LATE_STEP * period]
-    order = np.concatenate([long_first[np.argsort(-step[long_first], kind="stable")],
-                            likely[step[likely] < _LATE_STEP * period]])
-    n = len(r)
-    lost_at = np.zeros(n)  # samples lost just before each sample, as found so far
-    for i in order.tolist():
-        lo, hi = max(0, i - size + 1), min(n, i + 1 + size)
-        adj = r[lo:hi] - period * np.cumsum(lost_at[lo:hi])  # levels relative within the window
-        before = _floor(adj[: i + 1 - lo])
-        lost = int(np.rint((_floor(adj[i + 1 - lo:]) - before) / period))
-        # the step from a late sample is short by that sample's delay: count it in the room
-        room = int(np.rint((step[i] + max(0.0, adj[i - lo] - before)) / period))
-        if 1 <= lost <= room:
-            lost_at[i + 1] = lost
-    found = np.flatnonzero(lost_at)
-    return [Gap(int(j), float(step[j - 1]), int(lost_at[j])) for j in found]
+    def stretch_of(lo: int, hi: int) -> np.ndarray:
+        r = residual(t, period, lo, hi)
+        return r if lost is None else r - period * lost(lo, hi)
+
+    parts = [_floors(stretch_of(lo, min(lo + stretch, len(t))), size) for lo in range(0, len(t), stretch)]
+    return (np.concatenate([v for v, _ in parts]),
+            np.concatenate([at + i * stretch for i, (_, at) in enumerate(parts)]))
+
+
+def _steps(t: np.ndarray):
+    """The steps of `t` a cache-sized stretch at a time (no array of every step)."""
+    n = len(t) - 1
+    for a in range(0, n, _STRETCH):
+        b = min(a + _STRETCH, n)
+        yield t[a + 1:b + 1] - t[a:b]
+
+
+def _step_range(t: np.ndarray) -> tuple[float, float]:
+    """Shortest and longest step of `t`."""
+    lo, hi = np.inf, -np.inf
+    for step in _steps(t):
+        lo, hi = min(lo, float(step.min())), max(hi, float(step.max()))
+    return lo, hi
+
+
+def _count_steps_over(t: np.ndarray, limit: float) -> int:
+    """Steps of `t` longer than `limit`."""
+    return sum(int(np.count_nonzero(step > limit)) for step in _steps(t))
 
 
 def analyse_time(t, *, has_time: bool = True) -> TimeBase:
@@ -251,34 +224,33 @@ def analyse_time(t, *, has_time: bool = True) -> TimeBase:
         Whether the stamps came from the data; a time base built from a declared rate is
         regular but may still hold gaps (rows dropped for saturation).
     """
+    # long function: the facts in the order they depend on each other, each pass a stretch at a time
     t = np.asarray(t, dtype=float)
     if t.ndim != 1 or len(t) < 2:
         raise InputError(f"a time base needs at least two sample times, got shape {t.shape}")
-    step = np.diff(t)
     period = nominal_period(t)
     # up to 20 000 evenly spread steps for the median and the jitter: exact enough, and cheap on long logs
-    sample = step[np.linspace(0, len(step) - 1, min(len(step), 20_000)).astype(np.intp)]
-    regular = float(step.max() - step.min()) <= 1e-9 * period * len(t)  # a clock's own stamps, up to rounding
+    spread = np.linspace(0, len(t) - 2, min(len(t) - 1, 20_000)).astype(np.intp)
+    sample = t[spread + 1] - t[spread]
+    shortest, longest = _step_range(t)
+    regular = longest - shortest <= 1e-9 * period * len(t)  # a clock's own stamps, up to rounding
     gaps: list[Gap] = []
     clock = (float(t[0]), float(t[-1] - t[0]) / (len(t) - 1))
     if not regular:
-        r = t - t[0] - period * np.arange(len(t))  # clock residual; its lower envelope: the least-delayed samples
         size = _block_size(period, len(t))
-        floor, at = _floors(r, size)
-        gaps = _find_gaps(r, step, period, floor, size)
+        floor, at = _residual_floors(t, period, size)  # lower envelope of the clock residual: least-delayed samples
+        found = find_gaps(t, period, floor, size)
+        gaps = found.gaps
         k = None
         if gaps:  # the envelope again, with the lost samples counted (a block may straddle a gap)
-            lost = np.zeros(len(t))
-            for g in gaps:
-                lost[g.index] = g.lost
-            lost = np.cumsum(lost)
-            floor, at = _floors(r - period * lost, size)
-            k = at + lost[at]
+            floor, at = _residual_floors(t, period, size, found.upto_range)
+            k = at + found.upto(at)
         clock = _fit_clock(t, period, floor, at if k is None else k)
         if gaps:
             keep = np.ones(len(sample), dtype=bool)
-            keep[np.isin(np.linspace(0, len(step) - 1, len(sample)).astype(np.intp), [g.index - 1 for g in gaps])] = 0
+            keep[np.isin(spread, [g.index - 1 for g in gaps])] = 0
             sample = sample[keep] if keep.any() else sample
+    late = _count_steps_over(t, _LATE_STEP * period) if longest > _LATE_STEP * period else 0
     return TimeBase(
         n=len(t),
         span=float(t[-1] - t[0]),
@@ -286,7 +258,7 @@ def analyse_time(t, *, has_time: bool = True) -> TimeBase:
         mean_step=float(t[-1] - t[0]) / (len(t) - 1),
         median_step=float(np.median(sample)),
         jitter=float(sample.std()) if len(sample) > 1 else 0.0,
-        delayed=int(np.count_nonzero(step > _LATE_STEP * period)) - sum(g.step > _LATE_STEP * period for g in gaps),
+        delayed=late - sum(g.step > _LATE_STEP * period for g in gaps),
         gaps=tuple(gaps),
         has_time=has_time,
         regular_clock=clock is not None,

@@ -24,8 +24,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .longrun import block_means, find_lines, fit_level, newey_west_var
-from .observations import Observation, observe
+from .longrun import block_means, find_lines, fit_levels, newey_west_var
+from .observations import Observation, observe_many
 from .recording import Recording
 from .windows import Window
 
@@ -34,38 +34,25 @@ __all__ = ["observe_windows"]
 _STATS_RATE = 200.0  # [Hz] rate of the block means behind the plateau and static statistics
 
 
-def _samples(rec: Recording, w: Window) -> np.ndarray:
-    # Column-major windows make the per-axis reductions contiguous (about 4x faster than C order):
-    # readers give column-major recordings; others are copied window by window, not whole.
-    samples = rec.gyro[w.start:w.stop]
-    return samples if rec.gyro.flags.f_contiguous else np.asfortranarray(samples)
-
-
-def _observe(rec: Recording, w: Window, reference: str, speed, times, **stats) -> Observation:
-    samples, t = _samples(rec, w), times[w.start:w.stop]
-    if w.kind == "static":
-        return observe(samples, rec.sample_rate, "static", t=t, **stats)
-    if reference == "speed":
-        return observe(samples, rec.sample_rate, "speed", speed=speed, t=t, **stats)
-    return observe(samples, rec.sample_rate, "angle", angle=w.angle, t=t)
-
-
 #: Block-mean samples enough for a pooled long-run variance (about 3 % precision); whole windows,
 #: spread over the session, are taken up to this many.
 _POOL_ROWS = 20_000
 
 
-def _pooled_lrv(residuals: list[np.ndarray]) -> np.ndarray:
-    """Long-run variance per block-mean sample (3,), pooled over windows' residuals (each mean zero)."""
-    total = sum(len(r) for r in residuals)
-    step = max(1, int(np.ceil(total / _POOL_ROWS)))
-    chosen = np.concatenate(residuals[::step])
+def _pooled_lrv(residuals: list, sizes: list[int]) -> np.ndarray:
+    """Long-run variance per block-mean sample (3,), pooled over windows' residuals (each mean zero).
+
+    `residuals[i]` is a window's residuals (n_i, 3), or a function giving them, so that only the windows
+    chosen (every `step`-th, up to :data:`_POOL_ROWS` rows) are computed; `sizes` are their lengths n_i.
+    """
+    step = max(1, int(np.ceil(sum(sizes) / _POOL_ROWS)))
+    chosen = np.concatenate([r() if callable(r) else r for r in residuals[::step]])
     return newey_west_var(chosen) * len(chosen)
 
 
 def observe_windows(rec: Recording, windows: Sequence[Window], reference: str, speed: float | None, *,
                     long_run: bool = True, ripple: bool = True,
-                    times: np.ndarray | None = None) -> tuple[Observation, ...]:
+                    times: np.ndarray | None = None, period: float | None = None) -> tuple[Observation, ...]:
     """Reduce every window of `rec` for the `reference` (``"speed"`` or ``"angle"``).
 
     Parameters
@@ -82,43 +69,62 @@ def observe_windows(rec: Recording, windows: Sequence[Window], reference: str, s
         mean of squares needs the plain mean).
     times : ndarray, shape (N,), optional
         Sample times [s] to integrate on; default the recording's stamps. The pipeline passes the
-        regular sensor clock rebuilt from them (:meth:`gyrocal.timebase.TimeBase.clock_times`).
+        regular sensor clock rebuilt from them when it has gaps (:meth:`gyrocal.timebase.TimeBase.clock_times`).
+    period : float, optional
+        The period [s] of a regular clock without gaps that the samples lie on (the pipeline knows it from
+        the time base, :attr:`gyrocal.timebase.TimeBase.clock_period`): the trapezoid weights on such a
+        clock are even, so the windows are weighted evenly and last ``count x period``; `times` is unused.
     """
-    times = rec.t if times is None else times
+    times = None if period is not None else rec.t if times is None else times
     stats: dict[int, dict] = {}
     if long_run or ripple:
         stats = _window_stats(rec, windows, reference, times, long_run=long_run, ripple=ripple)
-    return tuple(_observe(rec, w, reference, speed, times, **stats.get(i, {})) for i, w in enumerate(windows))
+    kinds = ["static" if w.kind == "static" else reference for w in windows]
+    return observe_many(rec.gyro, [w.start for w in windows], [w.stop for w in windows], rec.sample_rate, kinds,
+                        speed=speed, angles=[w.angle if k == "angle" else None for w, k in zip(windows, kinds)],
+                        t=times, period=period, levels=[stats.get(i, {}).get("level") for i in range(len(windows))],
+                        mean_vars=[stats.get(i, {}).get("mean_var") for i in range(len(windows))])
 
 
-def _window_stats(rec: Recording, windows: Sequence[Window], reference: str, times: np.ndarray, *,
+def _window_stats(rec: Recording, windows: Sequence[Window], reference: str, times: np.ndarray | None, *,
                   long_run: bool, ripple: bool) -> dict[int, dict]:
-    """``{window index: {"level": ..., "mean_var": ...}}`` for the plateaus and static windows."""
+    """``{window index: {"level": ..., "mean_var": ...}}`` for the plateaus and static windows (`times`
+    None: on a regular clock)."""
     d = max(1, int(round(rec.sample_rate / _STATS_RATE)))
     gyro = block_means(rec.gyro, d)  # one pass over the recording; windows take the blocks inside them
-    clock = block_means(np.asarray(times, dtype=float), d)
     span = {i: (-(-w.start // d), w.stop // d) for i, w in enumerate(windows)}
     blocks = {i: gyro[a:b] for i, (a, b) in span.items() if b - a >= 4}
     plateaus = [i for i in blocks if windows[i].kind == "rotation" and reference == "speed"]
     statics = [i for i in blocks if windows[i].kind == "static"]
-    lines: list[float] = []
-    if ripple and plateaus:
-        b = blocks[max(plateaus, key=lambda i: len(blocks[i]))]
-        lines = find_lines(b[:, int(np.argmax(np.abs(b.mean(axis=0))))])
     out: dict[int, dict] = {}
-    resid, factor = {}, {}
-    for i in plateaus:
-        t = clock[span[i][0]:span[i][1]]
-        t = (t - t[0]) / ((t[-1] - t[0]) / (len(t) - 1))  # block centres on the sample clock, in block steps
-        level, factor[i], resid[i] = fit_level(blocks[i], t, lines)
-        if ripple:
-            out[i] = {"level": level}
-    if long_run and plateaus:
-        lrv = _pooled_lrv([resid[i] for i in plateaus])
-        for i in plateaus:
-            out.setdefault(i, {})["mean_var"] = lrv * factor[i]
+    if plateaus:
+        out = _plateau_stats(blocks, span, plateaus, times, d, long_run=long_run, ripple=ripple)
     if long_run and statics:
-        lrv = _pooled_lrv([blocks[i] - blocks[i].mean(axis=0) for i in statics])
+        lrv = _pooled_lrv([lambda b=blocks[i]: b - b.mean(axis=0) for i in statics], [len(blocks[i]) for i in statics])
         for i in statics:
             out[i] = {"mean_var": lrv / len(blocks[i])}
+    return out
+
+
+def _plateau_stats(blocks: dict, span: dict, plateaus: list[int], times: np.ndarray | None, d: int, *,
+                   long_run: bool, ripple: bool) -> dict[int, dict]:
+    """Levels (ripple regressed out) and mean variances of the plateaus, block means of `d` samples."""
+    lines: list[float] = []
+    if ripple:
+        b = blocks[max(plateaus, key=lambda i: len(blocks[i]))]
+        lines = find_lines(b[:, int(np.argmax(np.abs(b.mean(axis=0))))])
+    if times is None:  # a regular clock: the block centres are whole block steps apart
+        ts = [np.arange(len(blocks[i]), dtype=float) for i in plateaus]
+    else:
+        clock = block_means(np.asarray(times, dtype=float), d)
+        ts = []
+        for i in plateaus:
+            t = clock[span[i][0]:span[i][1]]
+            ts.append((t - t[0]) / ((t[-1] - t[0]) / (len(t) - 1)))  # block centres on the sample clock, in block steps
+    fits = dict(zip(plateaus, fit_levels([blocks[i] for i in plateaus], ts, lines)))
+    out: dict[int, dict] = {i: {"level": fits[i][0]} for i in plateaus} if ripple else {}
+    if long_run:
+        lrv = _pooled_lrv([fits[i][2] for i in plateaus], [len(blocks[i]) for i in plateaus])
+        for i in plateaus:
+            out.setdefault(i, {})["mean_var"] = lrv * fits[i][1]
     return out

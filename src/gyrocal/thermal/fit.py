@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import DegenerateDesignError
-from ..models import kb_to_kg
+from ..models import KG_INDEX, kb_to_kg
 from .session import Steps
 
 __all__ = ["PointFit", "ThermalFit", "fit_point", "fit_session", "kg_eq19", "kg_from_beta", "omega_matrix"]
@@ -24,10 +24,10 @@ def omega_matrix(reference: np.ndarray) -> np.ndarray:
     """The paper's regressor matrix Omega-hat (12, 3n) for reference rates (n, 3) (eq. 15-17)."""
     n = len(reference)
     om = np.zeros((n, 3, 12))
-    wx, wy, wz = reference.T
-    om[:, 0, [0, 3, 4, 9]] = np.stack([wx, wy, wz, np.ones(n)], 1)  # wx = Kxx w~x + Kyx w~y + Kzx w~z + Bx
-    om[:, 1, [1, 5, 6, 10]] = np.stack([wy, wx, wz, np.ones(n)], 1)
-    om[:, 2, [2, 7, 8, 11]] = np.stack([wz, wx, wy, np.ones(n)], 1)
+    for e, (row, col) in enumerate(KG_INDEX):  # gyro axis `row` reads K[row, col] w~col (eq. 11)
+        om[:, row, e] = reference[:, col]
+    for row in range(3):
+        om[:, row, 9 + row] = 1.0  # ... + B[row]
     return om.reshape(3 * n, 12).T
 
 
