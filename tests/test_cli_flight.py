@@ -90,7 +90,7 @@ def test_a_bad_plot_path_fails_before_the_json_is_written(rest, tmp_path):
     assert "must end in .png, .pdf or .svg" in refused("noise", rest, "--units", "rad/s", "--json", noise,
                                                        "--plot", tmp_path / "allan.jpg")
     assert not noise.exists()
-    assert "two different files" in refused("noise", rest, "--units", "rad/s", "--json", tmp_path / "a.png",
+    assert "its own file name" in refused("noise", rest, "--units", "rad/s", "--json", tmp_path / "a.png",
                                             "--plot", tmp_path / "a.png")
 
 

@@ -134,7 +134,7 @@ def test_verify_needs_a_calibration_file(bench, tmp_path):
     save(SimulationTruth(protocol="servo", model=TRUE), tmp_path / "truth.json")
     line = refused("verify", tmp_path / "truth.json", folder / "test.csv", "--reference", folder / "ref.csv",
                    "--ref-units", "deg/s", "-o", tmp_path / "out")
-    assert "needs a calibration or thermal file" in line
+    assert "expected 'gyrocal.calibration' or 'gyrocal.thermal'" in line
 
 
 def test_compare_is_a_production_check(tmp_path):

@@ -232,8 +232,8 @@ def test_counts_must_be_integers_and_counts_are_not_deg_s(tmp_path, rng):
 
 def test_bad_arguments(tmp_path):
     path = write_table(tmp_path / "ok.csv", ["gx", "gy", "gz"], [[1, 2, 3], [1, 2, 4]])
-    bad(path, "units='furlongs' is not a known unit", UnitError, units="furlongs", sample_rate=1)
-    bad(path, "sensitivity=16.4 applies only to units='counts'", UnitError, sample_rate=1, sensitivity=16.4)
+    bad(path, "units 'furlongs' is not a known unit", UnitError, units="furlongs", sample_rate=1)
+    bad(path, "sensitivity applies only to units counts, not deg/s", UnitError, sample_rate=1, sensitivity=16.4)
     bad(path, "sample_rate must be finite and > 0", sample_rate=-5)
     bad(path, "saturation 'keep' is not accepted", sample_rate=1, saturation="keep")
     bad(path, "columns key 'gq' is not a known quantity", columns="gq=gx")

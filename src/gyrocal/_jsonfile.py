@@ -21,6 +21,8 @@ def write_json(path: str | os.PathLike, doc: dict) -> None:
 def read_json(path: str | os.PathLike) -> dict:
     """Read a JSON object, turning every failure into a :class:`FileFormatError`."""
     p = Path(path)
+    if p.is_dir():
+        raise FileFormatError(f"{p}: a folder, not a file")
     if not p.is_file():
         raise FileFormatError(f"{p}: no such file")
     try:

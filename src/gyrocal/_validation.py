@@ -9,6 +9,9 @@ import numpy as np
 
 from .errors import InputError, NonFiniteInputError
 
+#: 0 K in degC: no temperature reads below it.
+ABSOLUTE_ZERO = -273.15
+
 
 def finite_array(name: str, value, *, shape_tail: tuple[int, ...] = (), ndim: int | None = None) -> np.ndarray:
     """Return `value` as a float array, checking its trailing shape and finiteness."""
@@ -49,6 +52,11 @@ def positive(name: str, value: float) -> float:
     return v
 
 
+def temperature(name: str, value: float) -> float:
+    """Return `value` [degC] as a float, refusing anything not finite or below absolute zero."""
+    return at_least(name, value, ABSOLUTE_ZERO, " degC")
+
+
 def at_least(name: str, value: float, low: float, unit: str = "") -> float:
     """Return `value` as a float, refusing anything that is not finite and >= `low`."""
     try:
@@ -64,6 +72,6 @@ def refuse_options(options: dict, accepted: tuple[str, ...], what: str) -> None:
     """Refuse keyword options that `what` does not take, naming the first one (``param``)."""
     unknown = [k for k in options if k not in accepted]
     if unknown:
-        took = f"it takes {', '.join(accepted)}" if accepted else "it takes none"
+        took = f"it takes {', '.join(f'{{param:{a}}}' for a in accepted)}" if accepted else "it takes none"
         raise InputError(f"{{param}} does not apply to {what} ({took})", param=unknown[0],
                          value=options[unknown[0]])

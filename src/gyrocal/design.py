@@ -134,7 +134,7 @@ class Design:
         if not w or not all(isinstance(x, (Rotation, Static)) for x in w):
             raise InputError("windows must be a non-empty sequence of Rotation and Static windows")
         if not (math.isfinite(self.pause) and self.pause >= 0):
-            raise InputError(f"pause must be finite and >= 0 [s], got {self.pause!r}")
+            raise InputError(f"{{param}} must be finite and >= 0 [s], got {self.pause!r}", param="pause")
         object.__setattr__(self, "windows", w)
 
     @property

@@ -20,7 +20,8 @@ from ._jsonfile import read_json, write_json
 from .errors import FileFormatError, InputError
 
 __all__ = [
-    "KIND_MODULES", "FileKind", "from_document", "kinds", "load", "load_calibration", "load_thermal", "register",
+    "KIND_MODULES", "FileKind", "from_document", "kinds", "load", "load_calibration", "load_correction", "load_thermal",
+    "register",
     "save", "save_calibration", "save_thermal",
 ]
 
@@ -146,6 +147,17 @@ def load_thermal(path: str | os.PathLike):
     from .thermal.model import ThermalCalibration
 
     return load(path, ThermalCalibration)
+
+
+def load_correction(path: str | os.PathLike):
+    """Read a file that corrects data: a ``gyrocal.calibration`` or a ``gyrocal.thermal`` file.
+
+    Any other gyrocal file (a noise file, a verify report, ...) is refused with its format named.
+    """
+    from .calibration import Calibration
+    from .thermal.model import ThermalCalibration
+
+    return load(path, (Calibration, ThermalCalibration))
 
 
 def save_thermal(cal, path: str | os.PathLike) -> None:

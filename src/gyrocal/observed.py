@@ -102,6 +102,9 @@ def check_observed(observed, raw: np.ndarray, sample_rate: float, *, source: str
     """
     units = observed["units"]
     raw = np.asarray(raw, dtype=float)
+    if len(raw) and np.all(raw == raw[0]):
+        return (f"{source}: every reading is the same ({_shown(raw[0])} {units}): the sensor was not running, or the "
+                "columns are not the gyro's; the corrected file holds nothing but the calibration's offsets")
     q, now, then = _ratio(observed, raw, sample_rate)
     if not math.isfinite(q) or 1 / _SAME <= q <= _SAME:
         return None

@@ -90,7 +90,7 @@ def build_design(name: DesignName, speed: float, *, revolutions: float = 1.0, st
 def _density(noise_density) -> np.ndarray:
     d = np.broadcast_to(np.asarray(noise_density, dtype=float), (3,))
     if not np.all(np.isfinite(d)) or np.any(d <= 0):
-        raise InputError(f"noise_density must be > 0 [rad/s/sqrt(Hz)], got {noise_density!r}")
+        raise InputError(f"{{param}} must be > 0 [rad/s/sqrt(Hz)], got {d.tolist()}", param="noise_density")
     return d
 
 

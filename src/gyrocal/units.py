@@ -30,7 +30,8 @@ def _parse(name: str, value: str, allowed: tuple[str, ...]) -> str:
     key = str(value).strip().lower()
     unit = _ALIASES.get(key)
     if unit not in allowed:
-        raise UnitError(f"{name}={value!r} is not a known unit; use one of {', '.join(allowed)}")
+        raise UnitError(f"{{param}} {value!r} is not a known unit; use one of {', '.join(allowed)}", param=name,
+                        value=value)
     return unit
 
 

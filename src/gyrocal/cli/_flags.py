@@ -18,6 +18,10 @@ FLAGS: dict[str, str] = {
     # plan
     "target_scale": "--target-scale",
     "target_bias": "--target-bias",
+    "target_cross": "--target-cross",
+    "target_accel_scale": "--target-accel-scale",
+    "target_accel_offset": "--target-accel-offset",
+    "max_speed": "--max-speed",
     "sample_rate": "--sample-rate",
     "sensitivity": "--sensitivity",
     "output_units": "--output-units",
@@ -67,12 +71,19 @@ FLAGS: dict[str, str] = {
     "temp_quantum": "--temp-quantum",
     "duration": "--duration",
     "quantum": "--quantum",
-    "bias_instability": "--bias-instability",
     "rate_random_walk": "--rrw",
+    "bias_instability": "--bias-instability",
+    "revolutions": "--revolutions",
+    "ripple": "--ripple",
+    "ripple_freq": "--ripple-freq",
+    "temp_start": "--temp-start",
+    "temp_end": "--temp-end",
+    "pause": "--wait",
     # simulate --protocol multi-position, plan --design poses
     "poses": "--poses",
     "turn_deg": "--tilt",
     "static_duration": "--still",
+    "peak_rate_deg": "--peak-rate",
     "stamps": "--stamps",
     "gaps": "--gaps",
     # noise, thermal-bias, flight and VIO exports
@@ -124,7 +135,7 @@ FLAGS: dict[str, str] = {
 NOT_FLAGS: frozenset[str] = frozenset({
     "accel_source_units", "covariance", "correction", "accelerometer", "fit", "observed",
     "chi2", "dof", "p_value", "birge_ratio", "covariance_scaled", "residuals", "warnings", "noise_std_axes",
-    "max_abs_rate", "mounting_rotation",
+    "max_abs_rate", "mounting_rotation", "accel_noise_std", "targets",
 })
 
 

@@ -57,8 +57,9 @@ NoiseDensity = Annotated[Optional[str], typer.Option(
          "(default: none; --noise, or the study's own levels, apply).")]
 
 
-def noise_std(noise: float | None, density: str | None, sample_rate: float, default: float):
-    """Per-sample white noise (3,) [rad/s] from --noise or --noise-density."""
+def noise_std(noise: float | None, density: str | None, sample_rate: float, default: float, *,
+              allow_zero: bool = True):
+    """Per-sample white noise (3,) [rad/s] from --noise or --noise-density (> 0 unless `allow_zero`)."""
     import numpy as np
 
     from ..noise_file import noise_density_arg
@@ -68,8 +69,8 @@ def noise_std(noise: float | None, density: str | None, sample_rate: float, defa
     if density is not None:
         return noise_density_arg(density) * math.sqrt(sample_rate)
     value = default if noise is None else noise
-    if not (math.isfinite(value) and value >= 0):
-        raise InputError(f"--noise must be >= 0 rad/s, got {value:g}")
+    if not (math.isfinite(value) and (value > 0 or allow_zero and value == 0)):
+        raise InputError(f"--noise must be {'>=' if allow_zero else '>'} 0 rad/s, got {value:g}")
     return np.full(3, value)
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 from typing import Callable, Iterable
 
@@ -14,16 +15,22 @@ def check_output(
     *,
     flag: str = "-o",
     inputs: Iterable[Path | None] = (),
+    outputs: Iterable[Path | None] = (),
     force: bool = False,
     replaceable: Callable[[Path], bool] = lambda _: False,
     holds: str = "something else",
     folder: bool = False,
 ) -> None:
-    """Refuse an output that is an input, under a file, of the wrong kind (file or `folder`), or an
-    existing file that `replaceable` does not accept (same content, or a regenerable gyrocal output)
-    unless `force`. Writers of many files into a `folder` replace only their own names in it."""
+    """Refuse an output that is an input, another of the run's `outputs`, under a file, of the wrong
+    kind (file or `folder`), or an existing file that `replaceable` does not accept (same content, or
+    a regenerable gyrocal output) unless `force`. Writers of many files into a `folder` replace only
+    their own names in it."""
     if path is None:
         return
+    for other in outputs:
+        if other is not None and os.path.abspath(other) == os.path.abspath(path):
+            raise InputError(f"{flag} {path} is also where this command writes another output; give each output "
+                             "its own file name")
     parent = next((p for p in path.parents if p.exists()), None)
     if parent is not None and not parent.is_dir():
         raise InputError(f"{flag} {path}: {parent} is a file, not a folder; choose another path")

@@ -101,7 +101,8 @@ def writing_bar(rows: int | None):
     @contextlib.contextmanager
     def bar():
         with Progress(TextColumn("writing"), BarColumn(), TextColumn("{task.percentage:>3.0f} %"),
-                      TimeRemainingColumn(), console=err_console, transient=True) as progress:
+                      TimeRemainingColumn(), console=err_console, transient=True,
+                      disable=not err_console.is_terminal) as progress:  # a log file gets no bar (nor its blank line)
             task = progress.add_task("write", total=rows)
             yield lambda n: progress.advance(task, n)
 

@@ -31,9 +31,11 @@ def multi_position(model, gyro_kw, flags: dict, sample_rate, rng, settings):
 
     `flags`: the command's parameters (``poses``, ``tilt``, ``still``, ``accel_noise_density``, ``misalignment``).
     """
+    from .._validation import at_least
     from ..simulation.multiposition import hand_session
 
     density = 0.002 if flags["accel_noise_density"] is None else flags["accel_noise_density"]
+    at_least("accel_noise_density", density, 0.0, " m/s^2/sqrt(Hz)")
     rec, gyro, facts, extra = hand_session(model, gyro_kw=gyro_kw, poses=flags["poses"], tilt_deg=flags["tilt"],
                                            still=flags["still"], accel_noise_std=density * math.sqrt(sample_rate),
                                            misalignment_deg=flags["misalignment"], sample_rate=sample_rate, rng=rng)

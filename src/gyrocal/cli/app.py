@@ -7,6 +7,8 @@ and exit code 2; ``--debug`` shows the traceback instead.
 from __future__ import annotations
 
 import contextlib
+import functools
+import os
 import sys
 import warnings
 
@@ -14,6 +16,8 @@ try:
     import typer
     from rich.console import Console
     from rich.markup import escape
+    from rich.measure import Measurement
+    from rich.table import Table
 except ImportError:  # pragma: no cover - exercised only without the extra
     sys.stderr.write("gyrocal: the command line needs its extra: pip install 'gyrocal[cli]'\n")
     raise SystemExit(2) from None
@@ -27,8 +31,20 @@ from ._flags import flag
 HELP_ORDER: list[str] = []
 
 
+class _Interrupted(BaseException):
+    """Ctrl-C inside a command: typer would turn it into a silent exit 130, without the line that says
+    what became of the outputs."""
+
+
 class _OrderedGroup(TyperGroup):
-    """Lists commands in :data:`HELP_ORDER`, then any others by name, each with its whole first sentence."""
+    """Lists commands in :data:`HELP_ORDER`, then any others by name, each with its whole first sentence;
+    Ctrl-C inside a command reaches :func:`run` (as :class:`_Interrupted`)."""
+
+    def invoke(self, ctx):
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt as exc:
+            raise _Interrupted from exc
 
     def list_commands(self, ctx):
         names = super().list_commands(ctx)
@@ -56,8 +72,41 @@ app = typer.Typer(
     rich_markup_mode=None,  # help texts carry units in brackets, e.g. [deg/s]: not markup
     context_settings={"max_content_width": 100, "help_option_names": ["-h", "--help"]},
 )
-console = Console()
-err_console = Console(stderr=True)
+
+
+class _Console(Console):
+    """rich's console with two changes for a command line whose output users keep.
+
+    * A table is never narrower than its content: on a narrow terminal, or a pipe (80 columns),
+      rich would cut numbers to ``0.0…``; the table is printed at its natural width instead.
+    * A closed pipe (``gyrocal ... | head``) stops the printing, not the command: rich would exit
+      at once, before the outputs are written; here the rest of the text goes nowhere and the
+      command finishes with its own exit code.
+    """
+
+    def print(self, *objects, **kwargs) -> None:
+        tables = [o for o in objects if isinstance(o, Table)]
+        wide = self.options.update_width(10_000)
+        need = max((Measurement.get(self, wide, t).maximum for t in tables), default=0)
+        if need <= self.width:
+            super().print(*objects, **kwargs)
+            return
+        # print(width=) is capped at the terminal's width: widen the console itself for this call
+        setting = self._width
+        self.width = need
+        try:
+            super().print(*objects, **kwargs)
+        finally:
+            self._width = setting
+
+    def on_broken_pipe(self) -> None:
+        self.quiet = True
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, (sys.stderr if self.stderr else sys.stdout).fileno())
+
+
+console = _Console()
+err_console = _Console(stderr=True)
 _state = {"debug": False}
 
 
@@ -121,6 +170,13 @@ def message(exc: BaseException) -> str:
     return f"{getattr(exc, 'strerror', None) or exc}: {getattr(exc, 'filename', None) or ''}".strip(": ")
 
 
+@functools.cache
+def _click_command():
+    """The click command typer builds from :data:`app` (every command registers at import): built once, as
+    typer would rebuild it for every run in the same process (tests run hundreds)."""
+    return typer.main.get_command(app)
+
+
 def run(argv: list[str] | None = None) -> int:
     """Run the CLI; map library, OS and usage errors to one line and exit code 2."""
     if argv is not None and not argv:
@@ -129,7 +185,7 @@ def run(argv: list[str] | None = None) -> int:
         with warnings.catch_warnings():
             warnings.simplefilter("always", GyrocalWarning)
             warnings.showwarning = _show_warning
-            rv = app(args=argv, prog_name="gyrocal", standalone_mode=False)
+            rv = _click_command()(args=argv, prog_name="gyrocal", standalone_mode=False)
     except (GyrocalError, OSError) as exc:
         if _state["debug"]:
             raise
@@ -140,7 +196,7 @@ def run(argv: list[str] | None = None) -> int:
     except typer.Abort:
         err_console.print("aborted")
         return 1
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, _Interrupted):
         if _state["debug"]:
             raise
         err_console.print("interrupted; no output was left half written")
@@ -148,17 +204,24 @@ def run(argv: list[str] | None = None) -> int:
     except Exception as exc:
         if not _is_usage_error(exc) or _state["debug"]:
             raise
-        fail(usage_line(exc))
+        fail(usage_line(exc, argv))
         return 2
     # Without standalone mode, typer returns the code of a raised Exit instead of raising it.
     return rv if isinstance(rv, int) else 0
 
 
-def usage_line(exc) -> str:
+def _command_path(argv: list[str] | None) -> str:
+    """``gyrocal NAME`` for the first word of `argv` that names a command, else ``gyrocal``."""
+    names = {c.name or c.callback.__name__.replace("_", "-") for c in app.registered_commands}
+    word = next((a for a in argv or () if a in names), None)
+    return f"gyrocal {word}" if word else "gyrocal"
+
+
+def usage_line(exc, argv: list[str] | None = None) -> str:
     """One line for a command-line mistake (a missing option, a bad choice, a number that is not one),
     pointing to the help of the command it was typed for."""
     ctx = getattr(exc, "ctx", None)
-    where = ctx.command_path if ctx is not None else "gyrocal"
+    where = ctx.command_path if ctx is not None else _command_path(argv)
     param = getattr(exc, "param", None)
     cause = exc.__cause__
     errors = cause.errors() if cause is not None and hasattr(cause, "errors") else None
@@ -175,6 +238,7 @@ def usage_line(exc) -> str:
             text = f"{value!r}: {first.get('msg', '')}"
         line = f"invalid value for {name}: {text}"
     else:
-        line = exc.format_message().rstrip(".")
+        # click lists a missing choice's values one per line ("Choose from:\n\tjson,\n\t...")
+        line = " ".join(exc.format_message().split()).rstrip(".")
         line = line[:1].lower() + line[1:]
     return f"{line} (see '{where} --help')"

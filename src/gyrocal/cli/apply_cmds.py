@@ -46,12 +46,13 @@ def apply(
         "'gyrocal apply' already corrected.")] = False,
 ) -> None:
     """Correct a recording; gyro columns are replaced by corrected rates, other columns pass through."""
-    from ..files import load
-    from ..io import read_header_comment, write_recording
+    from ..files import load_correction
+    from ..io import check_csv_name, read_header_comment, write_recording
 
     refuse_swapped(calibration, recording, command="apply", usage="calibration file comes")
     check_output(output, inputs=(calibration, recording), force=force, replaceable=starts_with(f"# {_APPLIED}"))
-    cal = load(calibration)
+    check_csv_name(output)
+    cal = load_correction(calibration)
     comment = read_header_comment(recording)
     if not force and comment is not None and comment.startswith(_APPLIED):
         raise InputError(f"{recording.name} was written by 'gyrocal apply' ('# {comment[:60]}'): its rates are "

@@ -271,7 +271,7 @@ def calibrate(
     inputs = (Path(recording), windows)
     check_output(output, inputs=inputs, force=force, replaceable=same_document(doc),
                  holds="a different calibration or another file")
-    check_output(plot, flag="--plot", inputs=inputs + (output,), force=True)
+    check_output(plot, flag="--plot", inputs=inputs + (output,), outputs=(output,), force=True)
     # files first: a reader that closes stdout early (| head) must not cost the outputs
     if plot is not None:
         from ..windows import Window

@@ -214,15 +214,17 @@ def capture(
 ) -> None:
     """Record a live stream from a serial port; with --guide, walk through a calibration and calibrate."""
     from ..capture.recorder import Capture
+    from ..io import check_csv_name
 
     if columns:
         from ..io.columns import parse_columns
 
         columns = parse_columns(columns)
     check_output(output, force=force, holds="another file (a recording?)")
+    check_csv_name(output)
     cal_path = calibration or (output.with_suffix(".cal.json") if guide else None)
     if guide:
-        check_output(cal_path, flag="--cal", inputs=(output,), force=force, holds="another file")
+        check_output(cal_path, flag="--cal", inputs=(output,), outputs=(output,), force=force, holds="another file")
     progress = _Progress(quiet)
     speed_rad = None if speed is None else math.radians(speed)
     reading = _ReadAs(units, sensitivity, sample_rate, accel_units, accel_sensitivity)

@@ -69,7 +69,7 @@ def imu(
                          param="accel_units")
     if accel_columns is not None and accel_log is None:
         raise InputError("--accel-columns is for --accel-log; map the recording's own columns with --columns ax=...")
-    check_output(plot, flag="--plot", inputs=(recording, windows, output, accel_log), force=True)
+    check_output(plot, flag="--plot", inputs=(recording, windows, output, accel_log), outputs=(output,), force=True)
     rec = read_from_flags(recording, units=units, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
                           sensitivity=sensitivity, output_units=output_units, topic=topic, saturation=saturation,
                           no_unit_check=no_unit_check, accel_units=None if accel_log else accel_units,

@@ -85,13 +85,11 @@ def noise(
 
     # every output is checked before anything is read, computed or written
     check_output(json_out, flag="--json", inputs=(recording,), force=force, replaceable=json_format(FORMAT))
-    check_output(plot, flag="--plot", inputs=(recording, json_out), force=True)
+    check_output(plot, flag="--plot", inputs=(recording, json_out), outputs=(json_out,), force=True)
     if plot is not None:
         from ..plotting import check_figure_path
 
         check_figure_path(plot)
-        if json_out is not None and plot.absolute() == json_out.absolute():
-            raise InputError(f"--plot and --json are both {plot}; give two different files")
     unit = required_units(units)
     if unit == "counts" and sensitivity is None:
         raise InputError("noise figures are physical quantities, so raw counts need their sensitivity",
@@ -101,6 +99,9 @@ def noise(
                           sensitivity=sensitivity,
                           output_units=output_units, topic=topic, no_unit_check=no_unit_check,
                           accel_units=accel_units, accel_sensitivity=accel_sensitivity, gravity=gravity, imu=imu)
+    if rec.accel_units == "counts":
+        raise InputError("noise figures are physical quantities, so raw accelerometer counts need their sensitivity",
+                         param="accel_sensitivity", hint="give {param} (LSB per g, e.g. 16384 for +-2 g)")
     report = characterise_recording(rec, motion=motion, source={"file": recording.name})
     shown = parse_rate_unit(output_units or "deg/s") if unit == "counts" else unit
     fs = report.sample_rate

@@ -90,19 +90,25 @@ def plan(
     from rich.markup import escape
     from rich.table import Table
 
+    from .._validation import positive
+
     refuse_unused(ctx, _DESIGN_FLAGS, design, "--design")
+    positive("max_speed", max_speed)
+    for name in ("target_scale", "target_cross", "target_accel_scale", "target_accel_offset"):
+        if ctx.params[name] is not None:
+            positive(name, ctx.params[name])
     if design == "poses":
         targets = {"gyro_scale": target_scale, "gyro_bias": _rate_arg("--target-bias", target_bias, "rad/s"),
                    "gyro_cross": target_cross, "accel_cross": target_cross, "accel_scale": target_accel_scale,
                    "accel_offset": target_accel_offset}
-        density = noise_std(noise, noise_density, sample_rate, 0.0017) / math.sqrt(sample_rate)
+        density = noise_std(noise, noise_density, sample_rate, 0.0017, allow_zero=False) / math.sqrt(sample_rate)
         return _plan_poses(poses, tilt, still, peak_rate, sample_rate, accel_noise_density, float(np.mean(density)),
                            {k: v for k, v in targets.items() if v is not None})
 
     from ..models import ScaleBias
     from ..planning import predict, suggest
 
-    density = noise_std(noise, noise_density, sample_rate, 0.035) / math.sqrt(sample_rate)
+    density = noise_std(noise, noise_density, sample_rate, 0.035, allow_zero=False) / math.sqrt(sample_rate)
     model = ScaleBias(np.asarray(triple("--k", k, (1.0, 1.0, 1.0))), np.zeros(3))
     options = dict(sample_rate=sample_rate, noise_density=density, model=model, static_duration=wait, pause=wait)
     given = predict(design, speed=math.radians(speed), revolutions=revolutions, **options)

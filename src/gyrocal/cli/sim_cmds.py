@@ -140,7 +140,7 @@ def simulate(
     sensitivity: Annotated[Optional[float], typer.Option(
         "--sensitivity", help="--units counts: LSB per deg/s of the written integers, e.g. 131 for an MPU-9250 at "
                               "+-250 deg/s (required there; add --full-scale to clip at the sensor's range).")] = None,
-    seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
+    seed: Annotated[int, typer.Option("--seed", help="Random seed.", min=0)] = 0,
     reference: Annotated[Optional[Path], typer.Option(
         "--reference", help="Also write the log of a reference gyro on the same motion (its own clock, mount, rate "
                             "and noise; the truth goes to the sidecar), for planning 'gyrocal verify' (default: none).")] = None,
@@ -175,7 +175,7 @@ def simulate(
     from ..files import save
     from ..io import write_recording
     from ..models import ScaleBias
-    from ..simulation.truth import SimulationTruth, truth_path
+    from ..simulation.truth import SimulationTruth
     from ..units import parse_rate_unit
 
     refuse_unused(ctx, _PROTOCOL_FLAGS, protocol, "--protocol")
@@ -187,7 +187,8 @@ def simulate(
                             noise=(noise, noise_density), sample_rate=sample_rate, seed=seed, wire=wire, faults=faults,
                             pace=pace, poses=poses, still=still)
     refuse_device_flags(ctx)
-    truth_file = _check_outputs(output, truth_path(output) if output else None, reference, profile, force)
+    truth_file = _check_outputs(output, reference, profile, force)
+    ref_unit = parse_rate_unit(ref_units, "ref_units")
     unit = output_unit(units, sensitivity)
     rng = np.random.default_rng(seed)
     sd = noise_std(noise, noise_density, sample_rate, 0.035 if protocol not in ("turntable", "static") else 0.005)
@@ -221,7 +222,6 @@ def simulate(
         rec, facts = _time_defects(rec, facts, settings, stamps, late_per_minute, gaps, gap_length, reference, rng)
     write_output(output, rec, unit, sensitivity, settings, f"{_SIMULATED} --protocol {protocol}", large=bool(size))
     if ref_rec is not None:
-        ref_unit = parse_rate_unit(ref_units, "ref_units")
         write_recording(reference, ref_rec, units=ref_unit,
                         header_comment=f"{_SIMULATED} reference of {output.name}; gyro in {ref_unit}, t in s "
                                        "on the reference clock")
@@ -231,19 +231,22 @@ def simulate(
                   f"{truth_file}", highlight=False)
 
 
-def _check_outputs(output: Path | None, truth_file: Path | None, reference: Path | None, profile: Path | None,
-                   force: bool) -> Path:
+def _check_outputs(output: Path | None, reference: Path | None, profile: Path | None, force: bool) -> Path:
     """Refuse outputs that would destroy something, before anything is simulated; the truth file's path."""
-    from ..simulation.truth import SimulationTruth
+    from ..io import check_csv_name
+    from ..simulation.truth import SimulationTruth, truth_path
 
-    if output is None or truth_file is None:
+    if output is None:
         raise InputError("give -o FILE.csv for the recording (or --device to serve a session on a pseudo-terminal)")
     check_output(output, inputs=(profile,), force=force, replaceable=starts_with(f"# {_SIMULATED}"))
+    check_csv_name(output)
+    truth_file = truth_path(output)
     check_output(truth_file, flag="truth file", inputs=(profile,), force=force,
                  replaceable=json_format(SimulationTruth.FORMAT))
     if reference is not None:
-        check_output(reference, flag="--reference", inputs=(profile, output, truth_file), force=force,
-                     replaceable=starts_with(f"# {_SIMULATED}"))
+        check_output(reference, flag="--reference", inputs=(profile, output, truth_file),
+                     outputs=(output, truth_file), force=force, replaceable=starts_with(f"# {_SIMULATED}"))
+        check_csv_name(reference)
     return truth_file
 
 
@@ -259,13 +262,14 @@ def _refuse_reference_flags(ctx: typer.Context, reference: Path | None) -> None:
 def _reference_log(t, true_rates, path: Path, rng, *, sample_rate: float, offset: float, drift: float,
                    mounting: float, noise: float | None):
     """The reference recording and its truth for the sidecar (reference flags name themselves in errors)."""
-    from .._validation import at_least
+    from .._validation import at_least, positive
     from ..models import ScaleBias
     from ..simulation import VirtualGyro
     from ..simulation.reference import ADIS16465_NOISE_DENSITY, simulate_reference
     from ._reading import prefixed_params
 
     with prefixed_params("ref_"):
+        sample_rate = positive("sample_rate", sample_rate)
         sd = ADIS16465_NOISE_DENSITY * math.sqrt(sample_rate) if noise is None else at_least("noise_std", noise, 0.0,
                                                                                               " rad/s")
         gyro = VirtualGyro(ScaleBias((1.0, 1.0, 1.0), (0.0, 0.0, 0.0)), noise_std=sd)

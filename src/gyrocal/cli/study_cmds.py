@@ -32,7 +32,7 @@ def study(
     out: Annotated[Path, typer.Option("-o", "--output", help="Output folder for figures and tables.")],
     gyros: Annotated[Optional[int], typer.Option("--gyros", help="Simulated gyros (default: the paper's).")] = None,
     reps: Annotated[Optional[int], typer.Option("--reps", help="Calibrations per gyro (default: the paper's).")] = None,
-    seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
+    seed: Annotated[int, typer.Option("--seed", help="Random seed.", min=0)] = 0,
     methods: Annotated[Optional[str], typer.Option(
         "--methods", help="servo-speed: estimators, comma-separated (algorithm1, lm, first-moment) (default: "
         "all three).")] = None,
@@ -51,7 +51,12 @@ def study(
     check_output(out, folder=True)
     options: dict = {}
     if methods is not None:
+        from ..choices import Method, values
+
         options["methods"] = tuple(m.strip() for m in methods.split(",") if m.strip())
+        if not options["methods"] or not set(options["methods"]) <= set(values(Method)):
+            raise InputError(f"--methods takes a comma-separated list of {', '.join(values(Method))}, got "
+                             f"{methods!r}")
     if not (math.isfinite(speed) and speed > 0):
         raise InputError(f"--speed must be > 0 deg/s, got {speed:g}")
     if not (math.isfinite(sample_rate) and sample_rate > 0):

@@ -43,11 +43,13 @@ def _units(units: str, output_units: str | None, sensitivity: float | None) -> t
 
 
 def _full_scale(value: float | None, units: str, rate_unit: str, sensitivity: float | None) -> float | None:
-    """--full-scale in rad/s."""
+    """--full-scale in rad/s (checked as the user typed it, in the data's unit)."""
+    from .._validation import positive
     from ..units import parse_input_unit, unit_factor
 
     if value is None:
         return None
+    value = positive("full_scale", value)
     if parse_input_unit(units) == "counts":
         return value / sensitivity * unit_factor(rate_unit)
     return value * unit_factor(units)

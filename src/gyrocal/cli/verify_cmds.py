@@ -103,6 +103,10 @@ def _write_outputs(folder: Path, report, series, stretch, figures: bool) -> list
     from ..files import save
     from ..verify.summary import summary_markdown
 
+    if figures:  # a stretch outside the logs is refused before anything is written
+        from ..plotting.verify import check_stretch
+
+        check_stretch(series.t, stretch)
     folder.mkdir(parents=True, exist_ok=True)
     written = [folder / "verify.json", folder / "summary.md"]
     save(report, written[0])
@@ -168,14 +172,14 @@ def verify(
                           "minute of a long log).")] = None,
     figures: Annotated[bool, typer.Option("--figures/--no-figures", help="Draw before.png, after.png, errors.png.")]
     = True,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the bootstrap.")] = 0,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the bootstrap.", min=0)] = 0,
     replicates: Annotated[int, typer.Option("--replicates", help="Bootstrap replicates.", min=50)] = 1000,
     example: Annotated[bool, typer.Option(
         "--example", help="Use the bundled testing period of the example (the servo method of Wang et al.'s "
                           "MPU9250, repeating its turns) and its reference log (deg/s, 100 Hz, own clock).")] = False,
 ) -> None:
     """Check a calibration against a reference gyro that recorded the same motion (two clocks, two mounts)."""
-    from ..files import load
+    from ..files import load_correction
     from ..verify import verify_calibration
 
     if example:
@@ -187,10 +191,11 @@ def verify(
     if test is None or reference is None:
         raise InputError("give the test log and --reference REF (or --example for the bundled pair)")
     check_output(output, folder=True, inputs=(calibration, test, reference))
+    if test.exists() and reference.exists() and test.samefile(reference):
+        raise InputError(f"--reference {reference} is the test log itself; give the reference gyro's own log of the "
+                         "same motion")
     span = _stretch(stretch)
-    cal = load(calibration)
-    if not callable(getattr(cal, "apply", None)):
-        raise InputError(f"{calibration} holds a {cal.FORMAT} file; verify needs a calibration or thermal file")
+    cal = load_correction(calibration)
     rec = _read_test(test, cal, units, columns, skip_rows, sample_rate, topic, saturation, no_unit_check)
     ref = _read_reference(reference, ref_units, ref_columns, ref_skip_rows, ref_sample_rate, ref_sensitivity,
                           ref_topic, ref_saturation, ref_no_unit_check)

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._validation import temperature
 from .._version import __version__
 from ..errors import InputError
 from .thermal_bias import MAX_ORDER, ThermalBias
@@ -75,6 +76,9 @@ def px4_params(tb: ThermalBias, *, instance: int = 0, device_id: int | None = No
         raise InputError("PX4 applies TC_G parameters only to the gyro whose device id is TC_Gi_ID, and this fit "
                          "records none (it was not read from a ULog)", param="device_id",
                          hint="give the id (the CAL_GYROn_ID value) with {param}")
+    if not 0 <= int(dev) < 2**32:
+        raise InputError(f"{{param}} {dev} is not a PX4 device id (a 32-bit unsigned number)", param="device_id",
+                         value=dev, hint="give the CAL_GYROn_ID value")
     i = int(instance)
     tref = float(np.float32(round(tb.tref, 2)))
     coefs = tb.coefficients_about(tref)
@@ -112,7 +116,7 @@ def ardupilot_params(tb: ThermalBias, *, imu: int = 1, caltemp: float | None = N
         raise InputError(f"{{param}}={imu!r}: ArduPilot has temperature calibration sets INS_TCAL1..INS_TCAL3",
                          param="slot", value=imu)
     n = int(imu)
-    tcal = float(np.float32(tb.tref if caltemp is None else caltemp))
+    tcal = float(np.float32(tb.tref if caltemp is None else temperature("caltemp", caltemp)))
     c35 = tb.coefficients_about(ARDUPILOT_TREF)
     offset = tb.bias_at([tcal])[0]  # what the firmware's constant offsets must hold at Tcal (clipped like T)
     offs, caltemp_name = _ardupilot_names(n)

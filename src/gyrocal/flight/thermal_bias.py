@@ -26,7 +26,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from .._validation import finite_array, positive
+from .._validation import at_least, finite_array, positive
 from ..errors import GyrocalWarning, InputError
 from ..stillness import find_motion
 from .polyfit import ar1_covariance, choose_orders, segment_cv, vander
@@ -212,7 +212,7 @@ def fit_thermal_bias(gyro, temp, sample_rate: float, *, max_order: int = MAX_ORD
     if not 0 <= int(max_order) <= MAX_ORDER:
         raise InputError(f"{{param}} must be 0..{MAX_ORDER} (PX4 and ArduPilot evaluate cubics), got {max_order!r}",
                          param="max_order", value=max_order)
-    _check_input(g, t_raw, fs, min_span)
+    _check_input(g, t_raw, fs, at_least("min_span", min_span, 0.0, " degC"))
     size = max(10, int(round(block_s * fs)))
     course = temperature_course(t_raw, fs)
     gm, tm = _blocks(g, course.temp, course.valid, size)

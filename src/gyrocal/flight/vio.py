@@ -30,6 +30,7 @@ Kalibr users apply by hand) and is written into the file.
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 
@@ -56,8 +57,8 @@ def _walk(sensor, name: str, given: float | None, use_bound: bool) -> tuple[floa
     if use_bound and math.isfinite(bound):
         return bound, "not seen in the log: its 95 % upper bound from the longest averaging times"
     raise InputError(f"the {sensor.kind} random walk is not seen in this log (the Allan deviation never turns up)",
-                     param="use_bound", hint=f"log longer, give it ({name}), or use its 95 % upper bound {bound:.3g} "
-                                             "({param})")
+                     param="use_bound", hint=f"log longer, give it ({{param:{name}}}), or use its 95 % upper bound "
+                                             f"{bound:.3g} ({{param}})")
 
 
 def vio_values(report: NoiseReport, *, inflate: float = 1.0, accel_noise_density: float | None = None,
@@ -91,9 +92,22 @@ def vio_values(report: NoiseReport, *, inflate: float = 1.0, accel_noise_density
     out["accelerometer_random_walk"] = _walk(a, "accel_random_walk", accel_random_walk, use_bound)
     for key, (value, note) in out.items():
         if not (math.isfinite(value) and value > 0):
-            raise InputError(f"{key} must be > 0, got {value!r}", param=_PARAM.get(key), value=value)
+            name = "{param}" if key in _PARAM else key
+            raise InputError(f"{name} must be > 0, got {value!r}", param=_PARAM.get(key), value=value)
         out[key] = (value * inflate, note)
     return out
+
+
+#: A ROS graph resource name (ROS wiki, "Names"): what Kalibr's rostopic must be.
+_ROS_NAME = re.compile(r"[~/]?[A-Za-z][A-Za-z0-9_]*(/[A-Za-z][A-Za-z0-9_]*)*")
+
+
+def _rate(report: NoiseReport, update_rate: float | None) -> float:
+    """The IMU rate the values are discretised for [Hz]: `update_rate`, or the log's."""
+    rate = report.sample_rate if update_rate is None else float(update_rate)
+    if not (math.isfinite(rate) and rate > 0):
+        raise InputError(f"{{param}} must be > 0 Hz, got {update_rate!r}", param="update_rate", value=update_rate)
+    return rate
 
 
 def _source_lines(report: NoiseReport, inflate: float) -> list[str]:
@@ -107,9 +121,10 @@ def kalibr_yaml(report: NoiseReport, *, rostopic: str = "/imu0", update_rate: fl
                 inflate: float = 1.0, **given) -> str:
     """Kalibr's ``imu.yaml``. `given`: see :func:`vio_values`."""
     v = vio_values(report, inflate=inflate, **given)
-    rate = report.sample_rate if update_rate is None else float(update_rate)
-    if not (math.isfinite(rate) and rate > 0):
-        raise InputError(f"{{param}} must be > 0 Hz, got {update_rate!r}", param="update_rate", value=update_rate)
+    rate = _rate(report, update_rate)
+    if not _ROS_NAME.fullmatch(rostopic):
+        raise InputError(f"{{param}} {rostopic!r} is not a ROS topic name", param="rostopic", value=rostopic,
+                         hint="letters, digits, _ and /, starting with a letter or /, e.g. /imu0")
     units = {"accelerometer_noise_density": "m/s^2/sqrt(Hz)", "accelerometer_random_walk": "m/s^3/sqrt(Hz)",
              "gyroscope_noise_density": "rad/s/sqrt(Hz)", "gyroscope_random_walk": "rad/s^2/sqrt(Hz)"}
     lines = _source_lines(report, inflate)
@@ -124,7 +139,7 @@ def kalibr_yaml(report: NoiseReport, *, rostopic: str = "/imu0", update_rate: fl
 def vins_yaml(report: NoiseReport, *, update_rate: float | None = None, inflate: float = 1.0, **given) -> str:
     """The ``acc_n, gyr_n, acc_w, gyr_w`` block of a VINS-Mono / VINS-Fusion config."""
     v = vio_values(report, inflate=inflate, **given)
-    rate = report.sample_rate if update_rate is None else float(update_rate)
+    rate = _rate(report, update_rate)
     root = math.sqrt(rate)
     lines = _source_lines(report, inflate) + [
         f"# discrete-time values at {rate:g} Hz, as VINS-Mono's integration_base.h uses them: the continuous",

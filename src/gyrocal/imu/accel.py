@@ -362,7 +362,9 @@ def _result(m, a, o, cov, gravity, r, q, u, se, choice, gain) -> AccelFit:
 
 
 def _too_few_message(u, choice) -> str:
-    cov = coverage(u - u.mean(axis=0))
+    centred = u - u.mean(axis=0)
+    # one pose (a log at rest), or poses all alike, leave nothing around the centre: use the directions
+    cov = coverage(centred if np.all(np.linalg.norm(centred, axis=1) > 0) else u)
     need = max(0, 6 - cov.poses)
     where = ", ".join(f"{v:+.2f}" for v in cov.empty_cap_centre)
     more = (f"hold the board still in {need} more orientation(s)" if need

@@ -163,15 +163,16 @@ def predict_poses(poses: int = 24, turn_deg: float = 90.0, *, static_duration: f
         [m/s^2].
     """
     if int(poses) != poses or poses < 6:
-        raise InputError(f"poses must be a whole number >= 6, got {poses!r}")
+        raise InputError(f"{{param}} must be a whole number >= 6, got {poses!r}", param="poses")
     if not 0 < turn_deg <= 180:
-        raise InputError(f"turn_deg must be in (0, 180] deg, got {turn_deg!r}")
+        raise InputError(f"{{param}} must be in (0, 180] deg, got {turn_deg!r}", param="turn_deg")
     fs = positive("sample_rate", sample_rate)
     still, peak = positive("static_duration", static_duration), np.radians(positive("peak_rate_deg", peak_rate_deg))
     accel_se = positive("accel_noise_density", accel_noise_density) * np.sqrt(fs)
     gyro_se = positive("gyro_noise_density", gyro_noise_density) * np.sqrt(fs)
     if still <= DETECTOR_WINDOW:
-        raise InputError(f"static_duration must exceed {DETECTOR_WINDOW} s: the detector trims that much off each pose")
+        raise InputError(f"{{param}} must exceed {DETECTOR_WINDOW} s: the detector trims that much off each pose",
+                         param="static_duration")
     q = pose_sequence(int(poses), turn_deg)
     t, w, f, spans = _ideal_session(q, still, peak, fs, gravity)
     # the detector keeps a pose only where its whole moving window is still: half a window less at each end
@@ -206,6 +207,9 @@ def suggest_poses(targets: dict[str, float], *, pose_counts=(12, 16, 20, 24, 30,
     unknown = set(targets) - set(FIGURES)
     if unknown or not targets:
         raise InputError(f"targets must name some of {', '.join(FIGURES)}, got {sorted(targets)}")
+    bad = {k: v for k, v in targets.items() if not (np.isfinite(v) and v > 0)}
+    if bad:
+        raise InputError(f"every target must be a 1-sigma > 0, got {bad}", param="targets", value=bad)
     plans = [predict_poses(n, turn, **options) for n, turn in product(pose_counts, turns)]
     ok = [p for p in plans if all(p.figures()[k] <= v for k, v in targets.items())]
     if ok:

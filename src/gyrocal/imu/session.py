@@ -22,7 +22,7 @@ from typing import Literal
 
 import numpy as np
 
-from .._validation import finite_array, positive
+from .._validation import at_least, finite_array, positive
 from ..errors import InputError, SegmentationError
 from ..windows import Window
 from .accel import AccelFit, fit_accelerometer
@@ -181,7 +181,7 @@ def calibrate_imu(t, gyro, accel, *, gravity: float = 9.80665, windows: Sequence
             raise InputError(f"a still window ends past the recording's {len(t)} samples")
         statics = summarise_statics(t, gyro, accel, [(a, b) for a, b, _ in spans], [lab for _, _, lab in spans])
     else:
-        detection = detect_statics(t, gyro, accel, min_duration=min_static)
+        detection = detect_statics(t, gyro, accel, min_duration=at_least("min_static", min_static, 0.0, " s"))
         statics = detection.statics
     if not statics:
         raise SegmentationError(f"no still pose of {min_static:g} s or more was found; hold the board still "

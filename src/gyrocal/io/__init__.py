@@ -13,7 +13,7 @@ from .profile import read_profile
 from .reader import read_header_comment, read_recording
 from .session import read_session
 from .windowsfile import read_windows
-from .writer import recording_columns, write_csv, write_recording
+from .writer import check_csv_name, recording_columns, write_csv, write_recording
 
-__all__ = ["attach_accelerometer", "find_saturation", "read_flight_log", "read_header_comment", "read_profile", "read_recording", "read_session",
+__all__ = ["attach_accelerometer", "check_csv_name", "find_saturation", "read_flight_log", "read_header_comment", "read_profile", "read_recording", "read_session",
            "read_windows", "recording_columns", "write_csv", "write_recording"]

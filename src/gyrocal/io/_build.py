@@ -23,6 +23,9 @@ MIN_SAMPLE_RATE, MAX_SAMPLE_RATE = 0.5, 100e3
 #: Per-sample noise [rad/s] above any MEMS gyro's (0.001-0.05 typical): deg/s data declared as rad/s.
 #: It catches deg/s logs whose noise is at least 0.3 deg/s per sample; quieter ones need the peak test.
 MAX_PLAUSIBLE_NOISE_RAD_S = 0.3
+#: Beyond any sensor's readings in any unit (a 64-bit counter stays under 1e19): numbers a calibration
+#: cannot even square without overflow, refused whatever --no-unit-check says.
+MAX_MAGNITUDE = 1e20
 #: Samples the noise estimate looks at: enough for a robust median, bounded on long logs.
 NOISE_SAMPLES = 100_000
 
@@ -105,6 +108,31 @@ def _check_units(raw: np.ndarray, unit: str, sensitivity: float | None, source: 
         )
 
 
+#: A board at rest, or turned by hand, reads about one g; a median |a| outside this range [g] is a unit mistake.
+PLAUSIBLE_G = (0.5, 2.0)
+
+
+def _check_accel_units(accel: dict, gravity: float, source: str) -> None:
+    """Refuse accelerations whose typical size says another unit: m/s^2 read as g reads 9.8 g at rest."""
+    if accel.get("accel_units") != "m/s^2":
+        return  # counts without a sensitivity have no scale to check
+    a = accel["accel"]
+    level = float(np.median(np.linalg.norm(a[:: max(1, len(a) // NOISE_SAMPLES)], axis=1))) / gravity
+    if PLAUSIBLE_G[0] <= level <= PLAUSIBLE_G[1]:
+        return
+    declared = accel["accel_source_units"]
+    likely = {"g": "m/s^2", "m/s^2": "g"}.get(declared) if 7.0 < max(level, 1 / max(level, 1e-300)) < 14.0 else None
+    if declared == "counts":
+        fix = "check {param:accel_sensitivity} (LSB per g)"
+    elif likely is not None and (level > 1) == (declared == "g"):
+        fix = f"the data are almost surely in {likely}: use {{param}} {likely}"
+    else:
+        fix = "check {param} and the accelerometer columns"
+    raise UnitError(f"{source}: the accelerometer reads {level:.3g} g in a typical sample (declared {declared}), "
+                    "where a board at rest or turned by hand reads about 1 g", param="accel_units",
+                    hint=f"{fix} (or {{param:check_units}})")
+
+
 def _check_saturation(raw, full_scale, policy: str, source: str, extremes) -> np.ndarray | None:
     """Rows to keep (None: all); `extremes` are each axis's (max, min)."""
     if policy not in ("error", "drop", "ignore"):
@@ -151,22 +179,22 @@ STANDARD_GRAVITY = 9.80665
 def _accel_fields(data: dict, source: str, accel_units: str | None, accel_sensitivity: float | None,
                   gravity: float) -> dict:
     """The Recording's accelerometer fields from parsed ``ax, ay, az`` columns (none without `accel_units`)."""
+    g0 = positive("gravity", gravity)  # a nonsense value is refused even where no g is used
     if accel_units is None:
         if any(c in data for c in ACCEL):
             raise InputError(f"{source}: accelerometer columns are mapped but their unit is not given",
                              param="accel_units", hint="give {param} m/s^2, g or counts")
         if accel_sensitivity is not None:
-            raise UnitError("accel_sensitivity needs accel_units='counts'", param="accel_sensitivity")
+            raise UnitError("{param} needs {param:accel_units} counts", param="accel_sensitivity")
         return {}
     unit = accel_units.strip().lower().replace("m/s2", "m/s^2").replace("m/s/s", "m/s^2")
     if unit not in values(AccelUnit):
         raise UnitError(f"{{param}}={accel_units!r} is not a known unit; use one of {', '.join(values(AccelUnit))}",
                         param="accel_units", value=accel_units)
-    g0 = positive("gravity", gravity)
     if accel_sensitivity is not None:
         if unit != "counts":
-            raise UnitError(f"accel_sensitivity applies only to accel_units='counts', got {accel_units!r}",
-                            param="accel_sensitivity", value=accel_sensitivity)
+            raise UnitError(f"{{param}} applies only to {{param:accel_units}} counts, not {accel_units}",
+                            param="accel_sensitivity", value=accel_sensitivity, hint="leave it out, or give counts")
         accel_sensitivity = positive("accel_sensitivity", accel_sensitivity)
     raw = np.array([data["ax"], data["ay"], data["az"]], dtype=float).T
     if unit == "counts" and accel_sensitivity is None:
@@ -180,6 +208,21 @@ def _axis_labels(values) -> np.ndarray:
     """The axis column as text without surrounding blanks (one-letter labels have none to strip)."""
     labels = np.asarray(values, dtype=str)
     return labels if labels.dtype.itemsize == 4 else np.char.strip(labels)
+
+
+def _reading_options(units: str, output_units: str | None, sensitivity: float | None,
+                     sample_rate: float | None) -> tuple[str, str, float | None, float | None]:
+    """The unit, output unit, sensitivity and sample rate, checked before any data is looked at."""
+    unit = parse_input_unit(units, "units")
+    out_unit = parse_rate_unit(output_units, "output_units") if output_units is not None else "deg/s"
+    if sensitivity is not None:
+        if unit != "counts":
+            raise UnitError(f"{{param}} applies only to {{param:units}} counts, not {units}", param="sensitivity",
+                            value=sensitivity, hint="leave it out, or give counts")
+        sensitivity = positive("sensitivity", sensitivity)
+    if sample_rate is not None:
+        sample_rate = positive("sample_rate", sample_rate)  # refused even where a time column wins
+    return unit, out_unit, sensitivity, sample_rate
 
 
 def build_recording(
@@ -200,12 +243,7 @@ def build_recording(
 ) -> Recording:
     """Check parsed columns and convert them to a :class:`Recording` (see :func:`gyrocal.io.read_recording`)."""
     accel = _accel_fields(data, source, accel_units, accel_sensitivity, gravity)
-    unit = parse_input_unit(units, "units")
-    out_unit = parse_rate_unit(output_units, "output_units") if output_units is not None else "deg/s"
-    if sensitivity is not None:
-        if unit != "counts":
-            raise UnitError(f"sensitivity={sensitivity!r} applies only to units='counts', got units={units!r}")
-        sensitivity = positive("sensitivity", sensitivity)
+    unit, out_unit, sensitivity, sample_rate = _reading_options(units, output_units, sensitivity, sample_rate)
     n = len(data["gx"])
     if n < 2:
         raise InputError(f"{source}: {'no data rows' if n == 0 else 'a single data row'}; a recording needs at least two samples")
@@ -214,11 +252,15 @@ def build_recording(
     hi, lo = raw.max(axis=0), raw.min(axis=0)
     rates_finite = bool(np.isfinite(hi).all() and np.isfinite(lo).all())
     _check_finite(data, source, known_finite=("gx", "gy", "gz") if rates_finite else ())
+    if (peak := max(float(hi.max()), -float(lo.min()))) > MAX_MAGNITUDE:
+        raise InputError(f"{source}: readings reach {peak:.3g}, beyond any sensor in any unit; the column "
+                         "holds something else (an id, a time stamp, a checksum?)", param="columns",
+                         hint="map the gyro's columns with {param} gx=NAME,gy=NAME,gz=NAME")
     if "t" in data:
         t, has_time = np.asarray(data["t"], dtype=float), True  # a time column wins over sample_rate
         fs = _check_time(t, source)
     elif sample_rate is not None:
-        fs = positive("sample_rate", sample_rate)
+        fs = sample_rate
         t, has_time = np.arange(n) / fs, False
     else:
         raise InputError(
@@ -226,7 +268,8 @@ def build_recording(
             hint="give the sample rate ({param} HZ) or map the time column ({param:columns} t=NAME)"
         )
     if check_units:
-        _check_units(raw, unit, sensitivity, source, peak=max(float(hi.max()), -float(lo.min())))
+        _check_units(raw, unit, sensitivity, source, peak=peak)
+        _check_accel_units(accel, gravity, source)
     keep = _check_saturation(raw, full_scale, saturation, source, (hi, lo))
     if unit == "counts":
         factor = 1.0 if sensitivity is None else unit_factor(out_unit) / sensitivity

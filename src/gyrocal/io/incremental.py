@@ -30,6 +30,9 @@ class IncrementalCSV:
     """
 
     def __init__(self, path: str | os.PathLike, columns: Sequence[str], header_comment: str | None = None):
+        from .writer import check_csv_name
+
+        check_csv_name(path)
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         while True:

@@ -38,7 +38,23 @@ def _kind(path: Path) -> str:
         return "parquet"
     if magic.startswith((b"#ROSBAG V2.0", b"\x89MCAP", b"SQLite format")):
         return "bag"
+    if magic.lstrip().startswith((b"{", b"[")):
+        _refuse_json(path)
     return "text"  # .csv, .txt, .tsv, .dat and anything else that reads as a table
+
+
+def _refuse_json(path: Path) -> None:
+    """A JSON file given where a recording belongs: name what it is (a table never starts with '{')."""
+    import json
+
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8")) if path.stat().st_size < 50_000_000 else None
+    except (UnicodeDecodeError, ValueError):
+        return  # not JSON after all: let the table reader say what it finds
+    fmt = doc.get("format") if isinstance(doc, dict) else None
+    what = f"a gyrocal file ({fmt})" if isinstance(fmt, str) and fmt.startswith("gyrocal.") else "JSON"
+    raise InputError(f"{path.name} holds {what}, not a recording; give the log of the sensor's readings (CSV, "
+                     "Parquet, a bag or a flight log)")
 
 
 def read_recording(
@@ -133,6 +149,8 @@ def read_recording(
                          hint="give {param} m/s^2, g or counts (with the accelerometer sensitivity for counts)")
     accel = accel_units is not None
     kind = _kind(path)
+    if topic is not None and kind != "bag":
+        raise InputError(f"{{param}} applies to ROS bags only; {path.name} is a {kind} file", param="topic")
     if kind == "flight":
         from .flightlog import read_flight_log
 
@@ -142,7 +160,8 @@ def read_recording(
         return read_flight_log(path, imu=imu, units=units, check_units=check_units, saturation=saturation,
                                accel_units=accel_units)[0]
     if imu is not None:
-        raise InputError(f"imu applies only to PX4 ULog and ArduPilot DataFlash logs, not to {path.name}", param="imu")
+        raise InputError(f"{{param}} applies only to PX4 ULog and ArduPilot DataFlash logs, not to {path.name}",
+                         param="imu")
     if skip_rows is not None:
         if kind != "text":
             raise InputError(f"{{param}} applies to text tables only; {path.name} is a {kind} file", param="skip_rows")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import io
 import os
+from pathlib import Path
 
 import numpy as np
 
@@ -12,7 +13,23 @@ from .._atomic import atomic_path
 from ..errors import InputError
 from ..units import unit_factor
 
-__all__ = ["recording_columns", "write_csv", "write_recording"]
+__all__ = ["check_csv_name", "recording_columns", "write_csv", "write_recording"]
+
+#: Suffixes that name another format than the plain comma-separated text gyrocal writes; gyrocal's own
+#: readers go by them, so a CSV under such a name could not even be read back.
+_OTHER_FORMATS = {
+    ".parquet": "Parquet", ".pq": "Parquet", ".gz": "gzip", ".bz2": "bz2", ".xz": "xz", ".zst": "zstd",
+    ".lz4": "lz4", ".br": "brotli", ".zip": "zip", ".json": "JSON", ".bag": "a ROS bag", ".mcap": "MCAP",
+    ".db3": "a ROS 2 bag", ".ulg": "a PX4 ULog", ".bin": "a DataFlash log", ".png": "an image", ".pdf": "PDF",
+}
+
+
+def check_csv_name(path: str | os.PathLike) -> None:
+    """Refuse an output name whose suffix says another format than CSV (``rec.parquet``, ``rec.csv.gz``)."""
+    suffix = Path(path).suffix.lower()
+    if suffix in _OTHER_FORMATS:
+        raise InputError(f"{path}: gyrocal writes recordings as plain comma-separated text, not "
+                         f"{_OTHER_FORMATS[suffix]}; give the file a .csv name")
 
 
 def _columns(columns: dict) -> dict[str, np.ndarray]:
@@ -55,6 +72,7 @@ def write_csv(path: str | os.PathLike, columns: dict, *, header_comment: str | N
     progress : callable, optional
         Called with the number of rows written after each chunk (a progress bar).
     """
+    check_csv_name(path)
     arrays = _columns(columns)
     n = len(next(iter(arrays.values())))
     with atomic_path(path) as tmp:

@@ -15,7 +15,7 @@ from ..errors import InputError
 from .calibration import AXIS_COLORS
 from .figure import new_figure, outside_legend
 
-__all__ = ["default_stretch", "error_figure", "overlay_figure", "plot_errors", "plot_overlay"]
+__all__ = ["check_stretch", "default_stretch", "error_figure", "overlay_figure", "plot_errors", "plot_overlay"]
 
 _MAX_POINTS = 40_000  # per line; longer stretches are drawn every k-th sample
 MEAN_S = 1.0  # running mean of the error figure [s]: noise averages out, bias and scale errors stay
@@ -30,6 +30,11 @@ def default_stretch(t: np.ndarray, reference: np.ndarray, seconds: float = 60.0)
     ends = np.searchsorted(t, t + seconds)
     i = int(np.argmax(energy[ends] - energy[: len(t)]))
     return float(t[i]), float(t[i] + seconds)
+
+
+def check_stretch(t: np.ndarray, stretch: tuple[float, float] | None) -> None:
+    """Refuse a stretch [s] that holds fewer than 2 of the compared samples `t` (before anything is drawn)."""
+    _window(t, stretch)
 
 
 def _window(t: np.ndarray, stretch: tuple[float, float] | None) -> slice:

@@ -66,14 +66,14 @@ class VirtualGyro:
     def __post_init__(self):
         sd = np.broadcast_to(np.asarray(self.noise_std, dtype=float), (3,))
         if not np.all(np.isfinite(sd)) or np.any(sd < 0):
-            raise InputError(f"noise_std must be >= 0, got {self.noise_std!r}")
+            raise InputError(f"{{param}} must be >= 0, got {self.noise_std!r}", param="noise_std")
         for name in ("bias_instability", "rate_random_walk"):
             if not getattr(self, name) >= 0:
-                raise InputError(f"{name} must be >= 0, got {getattr(self, name)!r}")
+                raise InputError(f"{{param}} must be >= 0, got {getattr(self, name)!r}", param=name)
         for name in ("quantum", "full_scale"):
             value = getattr(self, name)
             if value is not None and not value > 0:
-                raise InputError(f"{name} must be > 0 when given, got {value!r}")
+                raise InputError(f"{{param}} must be > 0 when given, got {value!r}", param=name)
 
     def errors(self, n: int, temp: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
         """Deterministic ``(K, B)``, broadcastable against n samples."""

@@ -62,6 +62,9 @@ class VirtualImu:
             object.__setattr__(self, name, finite_array(name, getattr(self, name), shape_tail=shape, ndim=len(shape)))
         if np.linalg.cond(self.accel_matrix) > 1e8:
             raise InputError("accel_matrix is singular")
+        sd = np.asarray(self.accel_noise_std, dtype=float)
+        if not (np.all(np.isfinite(sd)) and np.all(sd >= 0)):
+            raise InputError(f"{{param}} must be >= 0, got {self.accel_noise_std!r}", param="accel_noise_std")
 
     def accel(self, f: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         """Readings (N, 3) for specific forces (N, 3) [m/s^2]."""
@@ -127,13 +130,17 @@ class MultiPositionProtocol:
                 raise InputError("orientations needs at least 2 poses")
             object.__setattr__(self, "orientations", q / np.linalg.norm(q, axis=1, keepdims=True))
         elif int(self.poses) != self.poses or self.poses < 2:
-            raise InputError(f"poses must be a whole number >= 2, got {self.poses!r}")
+            raise InputError(f"{{param}} must be a whole number >= 2, got {self.poses!r}", param="poses")
         lo, hi = self.static_duration
         if not 0 < lo <= hi:
-            raise InputError(f"static_duration must be (low, high) with 0 < low <= high, got {self.static_duration!r}")
+            raise InputError(f"{{param}} must be (low, high) with 0 < low <= high [s], got {self.static_duration!r}",
+                             param="static_duration")
         lo, hi = self.peak_rate_deg
         if not 0 < lo <= hi:
-            raise InputError(f"peak_rate_deg must be (low, high) with 0 < low <= high, got {self.peak_rate_deg!r}")
+            raise InputError(f"{{param}} must be (low, high) with 0 < low <= high [deg/s], got {self.peak_rate_deg!r}",
+                             param="peak_rate_deg")
+        if self.turn_deg is not None and not 0 < self.turn_deg <= 180:
+            raise InputError(f"{{param}} must be in (0, 180] deg, got {self.turn_deg!r}", param="turn_deg")
         positive("sample_rate", self.sample_rate)
         positive("gravity", self.gravity)
         if not 0 <= self.uneven_steps < 0.5:
@@ -321,6 +328,7 @@ def hand_session(gyro_model, *, gyro_kw: dict, poses: int = 24, tilt_deg: float 
     """
     from .gyro import VirtualGyro
 
+    positive("static_duration", still)  # before any draw: a bad value is refused as the user typed it
     gyro = mounted_gyro(gyro_model, misalignment_deg, rng)
     a, o = random_accelerometer(rng)
     imu = VirtualImu(VirtualGyro(gyro, **gyro_kw), accel_matrix=a, accel_offset=o, accel_noise_std=accel_noise_std)

@@ -105,26 +105,29 @@ class ServoProtocol:
             object.__setattr__(self, "revolutions", tuple(float(r) for r in self.revolutions))
         revs = np.atleast_1d(np.asarray(self.revolutions, dtype=float))
         if revs.size not in (1, len(self.turns)) or not np.all(revs > 0) or not np.all(np.isfinite(revs)):
-            raise InputError(f"revolutions must be one number > 0 or one per turn ({len(self.turns)}), "
-                             f"got {self.revolutions!r}")
+            raise InputError(f"{{param}} must be one number > 0 or one per turn ({len(self.turns)}), "
+                             f"got {self.revolutions!r}", param="revolutions")
         if not self.turns:
-            raise InputError("turns is empty; give at least one of +x, -x, +y, -y, +z, -z")
+            raise InputError("{param} is empty; give at least one of +x, -x, +y, -y, +z, -z", param="turns")
         object.__setattr__(self, "turns", tuple(self.turns))
         object.__setattr__(self, "_parsed", tuple(_parse_turn(t) for t in self.turns))
         waits = np.atleast_1d(np.asarray(self.wait, dtype=float))
         if waits.size not in (1, len(self.turns) - 1) and len(self.turns) > 1:
-            raise InputError(f"wait must be one value or {len(self.turns) - 1} (one per gap), got {waits.size}")
+            raise InputError(f"{{param}} must be one value or {len(self.turns) - 1} (one per gap), got {waits.size}",
+                             param="wait")
         for name in ("lead_in", "lead_out", "ramp", "vibration", "pause_length"):
             if not getattr(self, name) >= 0:
-                raise InputError(f"{name} must be >= 0, got {getattr(self, name)!r}")
+                raise InputError(f"{{param}} must be >= 0, got {getattr(self, name)!r}", param=name)
         if np.any(~(waits >= 0)):
-            raise InputError(f"wait must be >= 0 s, got {self.wait!r}")
+            raise InputError(f"{{param}} must be >= 0 s, got {self.wait!r}", param="wait")
         positive("vibration_freq", self.vibration_freq)
         positive("ripple_freq", self.ripple_freq)
         if not 0 <= self.ripple <= 0.5:
-            raise InputError(f"ripple must be in [0, 0.5] (a fraction of the speed), got {self.ripple!r}")
+            raise InputError(f"{{param}} must be in [0, 0.5] (a fraction of the speed), got {self.ripple!r}",
+                             param="ripple")
         if not 0 <= self.misalignment_deg <= 10:
-            raise InputError(f"misalignment_deg must be in [0, 10] deg, got {self.misalignment_deg!r}")
+            raise InputError(f"{{param}} must be in [0, 10] deg, got {self.misalignment_deg!r}",
+                             param="misalignment_deg")
         if not 0 <= self.unevenness <= 0.9:
             raise InputError(f"unevenness must be in [0, 0.9], got {self.unevenness!r}")
         if int(self.pauses) != self.pauses or self.pauses < 0:

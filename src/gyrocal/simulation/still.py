@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validation import finite_array, positive
+from .._validation import at_least, finite_array, positive, temperature
 from ..errors import InputError
 from ..recording import Recording
 from .gyro import VirtualGyro
@@ -89,10 +89,8 @@ class StillProtocol:
         positive("duration", self.duration)
         positive("temp_tau", self.temp_tau)
         for name in ("temp_start", "temp_end"):
-            if not math.isfinite(getattr(self, name)):
-                raise InputError(f"{name} must be a finite temperature in degC, got {getattr(self, name)!r}")
-        if not (math.isfinite(self.temp_noise) and self.temp_noise >= 0):
-            raise InputError(f"temp_noise must be >= 0 degC, got {self.temp_noise!r}")
+            temperature(name, getattr(self, name))
+        at_least("temp_noise", self.temp_noise, 0.0, " degC")
         if self.temp_quantum is not None:
             positive("temp_quantum", self.temp_quantum)
 
@@ -118,10 +116,9 @@ class StillAccelerometer:
     random_walk: float = 0.0
 
     def __post_init__(self):
-        for name in ("noise_density", "random_walk"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0):
-                raise InputError(f"{name} must be >= 0, got {value!r}")
+        # named as the flags of 'gyrocal simulate --protocol static' that set them
+        at_least("accel_noise_density", self.noise_density, 0.0)
+        at_least("accel_random_walk", self.random_walk, 0.0)
 
     def measure(self, n: int, sample_rate: float, rng: np.random.Generator) -> np.ndarray:
         """Readings (n, 3) [m/s^2]."""

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validation import at_least, positive
+from .._validation import at_least, positive, temperature
 from ..errors import InputError
 from ..recording import Recording
 from .gyro import VirtualGyro
@@ -67,6 +67,8 @@ class TurntableProtocol:
                 raise InputError(f"{{param}} must be one or more finite numbers, got {getattr(self, name)!r}",
                                  param=name)
             object.__setattr__(self, name, values)
+        for t in self.temps:
+            temperature("temps", t)
         if min(self.rates) < 0:
             raise InputError(f"{{param}} are magnitudes >= 0 deg/s (each runs forward and reverse), got "
                              f"{list(self.rates)}", param="rates", value=self.rates)

@@ -26,7 +26,6 @@ order); ``kg_user`` has B in input units and K scaled by output/input unit facto
 
 from __future__ import annotations
 
-import math
 import warnings
 from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar
@@ -35,7 +34,7 @@ import numpy as np
 
 from .._arrays import readonly
 from .._jsonfile import check_header, get, get_array
-from .._validation import finite_array, refuse_options
+from .._validation import at_least, finite_array, refuse_options, temperature
 from .._version import __version__
 from ..choices import OutOfRange, TableModel, values
 from ..errors import FileFormatError, InputError, UnitError
@@ -135,8 +134,8 @@ class ThermalCalibration:
                 object.__setattr__(self, name, readonly(arr, copy=True))
         object.__setattr__(self, "input_units", parse_rate_unit(self.input_units, "input_units"))
         object.__setattr__(self, "output_units", parse_rate_unit(self.output_units, "output_units"))
-        if not math.isfinite(self.reference_temp):
-            raise InputError(f"reference_temp must be a finite temperature in degC, got {self.reference_temp!r}")
+        temperature("reference_temp", self.reference_temp)
+        at_least("temp_tau", self.temp_tau, 0.0, " s")
         K, _ = kg_to_kb(self.kg)
         cond = np.linalg.cond(K)
         if np.any(~np.isfinite(cond) | (cond > 1e12)):

@@ -139,7 +139,7 @@ def find_steps(rec: Recording, *, settle: float = 2.0, full_scale: float | None 
     if rec.units != "rad/s":
         raise InputError("readings are raw counts without a sensitivity; give the sensitivity in LSB per unit")
     if settle < 0:
-        raise InputError(f"settle must be >= 0 s, got {settle!r}")
+        raise InputError(f"{{param}} must be >= 0 s, got {settle!r}", param="settle")
     t, rate, axis = rec.t, rec.table_rate, _axis_codes(rec.axis)
     n = len(t)
     gap = np.diff(t) > 5.0 / rec.sample_rate
@@ -150,8 +150,9 @@ def find_steps(rec: Recording, *, settle: float = 2.0, full_scale: float | None 
     count = stop - keep0
     ok = count >= max(int(min_samples), 2)
     if not ok.any():
-        raise InputError(f"no step of recording {source} keeps {max(int(min_samples), 2)} samples after the "
-                         f"{settle:g} s settling time; lower settle or check the table_rate column")
+        raise InputError(f"no rate step of the session{f' (recording {source + 1})' if source else ''} keeps "
+                         f"{max(int(min_samples), 2)} samples after the {settle:g} s settling time", param="settle",
+                         hint="lower {param}, or check the table_rate column")
     if not ok.all():
         warnings.warn(f"{int((~ok).sum())} step(s) have fewer than {max(int(min_samples), 2)} samples after "
                       f"the {settle:g} s settling time and were left out", DroppedStepsWarning, stacklevel=2)

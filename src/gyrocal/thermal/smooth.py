@@ -109,7 +109,7 @@ def fit_smooth(temps, values, max_order: int = 3) -> SmoothModel:
         raise InputError(f"a smooth model needs >= 3 temperature points with one row of values each, got {len(t)} "
                          f"temperatures and {y.shape[0]} rows")
     if int(max_order) < 0:
-        raise InputError(f"max_order must be >= 0, got {max_order!r}")
+        raise InputError(f"{{param}} must be >= 0, got {max_order!r}", param="max_order")
     top = min(int(max_order), len(t) - 2)
     centre, scale = float(t.mean()), float(max(np.ptp(t) / 2, 1e-12))
     u = (t - centre) / scale
