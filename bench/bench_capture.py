@@ -1,6 +1,7 @@
 """Sustained capture rate without loss at 115200 and 921600 baud (run by hand).
 
-For each baud rate and wire format: the byte budget (baud / 10 for 8N1) over the bytes per sample
+For each baud rate and wire format (gyrocal frames, 6-axis frames with the accelerometer, text lines):
+the byte budget (baud / 10 for 8N1) over the bytes per sample
 gives the highest possible sample rate; a virtual device in another process then sends a session
 at 95 % of that budget through a pseudo-terminal, paced at baud / 10 bytes per second, and
 ``gyrocal.capture.Capture`` records it. The run passes when every sample arrives (no sequence gap,
@@ -13,6 +14,7 @@ naive baseline in the same process, the decoder alone against a plain ``struct.u
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import multiprocessing as mp
 import tempfile
@@ -29,11 +31,16 @@ from gyrocal.models import ScaleBias
 from gyrocal.simulation import ServoProtocol
 
 
-def session(rate: float, seconds: float):
+def session(rate: float, seconds: float, accel: bool = False):
     turns = max(1, int(seconds // 9))
     proto = ServoProtocol(turns=("+x", "-x", "+y", "-y", "+z", "-z")[:turns], lead_in=1.0, lead_out=1.0)
     model = ScaleBias(k=np.array([1.02, 0.98, 1.01]), b=np.radians([1.5, -2.0, 0.8]))
-    return simulate_device_session(proto, model=model, noise_std=0.01, rng=np.random.default_rng(1), sample_rate=rate)
+    rng = np.random.default_rng(1)
+    s = simulate_device_session(proto, model=model, noise_std=0.01, rng=rng, sample_rate=rate)
+    if not accel:
+        return s
+    a = np.round(rng.normal([0.0, 0.0, 16384.0], 65.0, (len(s), 3))).astype(np.int16)  # flat, MPU-6050 noise
+    return dataclasses.replace(s, accel=a, accel_sensitivity=16384)
 
 
 def serve(data: bytes, byte_rate: float, conn) -> None:
@@ -45,27 +52,27 @@ def serve(data: bytes, byte_rate: float, conn) -> None:
 
 
 def run(baud: int, wire: str, seconds: float) -> dict:
-    per_sample = {"frames": fr.OVERHEAD + fr.Sample.FORMAT.size}
+    per_sample = {"frames": fr.OVERHEAD + fr.Sample.FORMAT.size, "6-axis": fr.OVERHEAD + fr.ImuSample.FORMAT.size}
     probe = session(200.0, 9)
     if wire == "text":
         per_sample["text"] = len(device_bytes(probe, "text")) / len(probe)
     budget = baud / 10 / per_sample[wire]
     rate = math.floor(0.95 * budget)
-    s = session(rate, seconds)
-    data = device_bytes(s, wire, encoder="python")
+    s = session(rate, seconds, accel=wire == "6-axis")
+    data = device_bytes(s, "text" if wire == "text" else "frames", encoder="python")
     parent, child = mp.Pipe()
     proc = mp.Process(target=serve, args=(data, baud / 10, child))
     proc.start()
     port = parent.recv()
     with tempfile.TemporaryDirectory() as tmp:
-        cap = Capture(port, Path(tmp) / "rec.csv", wire=wire, silence=30,
+        cap = Capture(port, Path(tmp) / "rec.csv", wire="text" if wire == "text" else "frames", silence=30,
                       on_event=lambda kind, _: parent.send("go") if kind == "open" else None)
         wall, cpu = time.monotonic(), time.process_time()
         result = cap.run()
         wall, cpu = time.monotonic() - wall, time.process_time() - cpu
     proc.join(60)
     st = result.stats
-    lost = (st.lost_samples + st.crc_errors) if wire == "frames" else st.bad_lines
+    lost = st.bad_lines if wire == "text" else st.lost_samples + st.crc_errors + len(s) - result.samples
     return {"baud": baud, "wire": wire, "bytes_per_sample": per_sample[wire], "budget_hz": budget, "rate_hz": rate,
             "sent": len(s), "received": result.samples, "lost": lost, "wall_s": wall, "cpu_s": cpu}
 
@@ -91,7 +98,7 @@ def main() -> None:
     print(f"{'baud':>7} {'wire':>6} {'B/sample':>9} {'budget Hz':>10} {'sent Hz':>8} {'sent':>7} {'received':>9} "
           f"{'lost':>5} {'link s':>7} {'capture CPU':>12}")
     for baud in (115200, 921600):
-        for wire in ("frames", "text"):
+        for wire in ("frames", "6-axis", "text"):
             r = run(baud, wire, args.seconds)
             print(f"{r['baud']:>7} {r['wire']:>6} {r['bytes_per_sample']:>9.1f} {r['budget_hz']:>10.0f} "
                   f"{r['rate_hz']:>8} {r['sent']:>7} {r['received']:>9} {r['lost']:>5} {r['wall_s']:>7.1f} "

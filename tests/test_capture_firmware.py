@@ -38,18 +38,20 @@ def example(tmp_path_factory):
                                   extra_sources=[EXAMPLE / "gyrocal_example.c", EXAMPLE / "host_board.c"])
     dll = ctypes.CDLL(str(path))
     dll.example_run.restype = ctypes.c_size_t
-    dll.example_run.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_uint32, ctypes.c_float,
-                                ctypes.c_float, ctypes.c_void_p, ctypes.c_size_t]
+    dll.example_run.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_uint32,
+                                ctypes.c_float, ctypes.c_float, ctypes.c_uint16, ctypes.c_void_p, ctypes.c_size_t]
     return dll, CDevice(firmware.load_library(path.parent))
 
 
 def run_example(dll, s) -> bytes:
     raw = np.ascontiguousarray(s.raw, dtype=np.int16)
+    acc = None if s.accel is None else np.ascontiguousarray(s.accel, dtype=np.int16)
     t = np.ascontiguousarray(s.t_us, dtype=np.uint32)
     temp = None if s.temp is None else np.ascontiguousarray(np.round(s.temp * 100), dtype=np.int16)
     out = np.zeros(64 * len(raw) + 1024, dtype=np.uint8)
-    n = dll.example_run(raw.ctypes.data, t.ctypes.data, None if temp is None else temp.ctypes.data, len(raw),
-                        s.sample_rate, s.sensitivity, out.ctypes.data, len(out))
+    n = dll.example_run(raw.ctypes.data, None if acc is None else acc.ctypes.data, t.ctypes.data,
+                        None if temp is None else temp.ctypes.data, len(raw), s.sample_rate, s.sensitivity,
+                        s.accel_sensitivity or 0, out.ctypes.data, len(out))
     assert n > 0
     return out[:n].tobytes()
 
@@ -157,3 +159,24 @@ def test_a_device_that_computes_otherwise_is_caught(session, sent):
     moved[2] = dataclasses.replace(latest[2], mean=(latest[2].mean[0] + 0.1, *latest[2].mean[1:]))
     agreement = check_device(moved, result, samples)
     assert agreement.means_ratio > 1 and not agreement.agrees
+
+
+def test_six_axis_firmware_sends_the_accelerometer(example):
+    """With an accelerometer sensitivity the example firmware sends 6-axis frames: every sample decodes to what
+    the fake board read (gyro, accelerometer, stamp), the hello carries the sensitivity, the end frame the count,
+    and the virtual device's C-driven stream is the firmware's, byte for byte."""
+    from gyrocal.capture.pose_guide import guided_directions
+    from gyrocal.capture.simulated_imu import simulate_device_imu_session
+
+    dll, cdev = example
+    s = simulate_device_imu_session(guided_directions()[:4], rng=np.random.default_rng(1606))
+    sent = run_example(dll, s)
+    assert cdev.firmware_stream(s.raw, s.t_us, s.temp, sample_rate=s.sample_rate, sensitivity=s.sensitivity,
+                                accel=s.accel, accel_sensitivity=s.accel_sensitivity) == sent
+    frames = fr.FrameDecoder().feed(sent)
+    six = by_type(frames, fr.ImuSample)
+    assert not by_type(frames, fr.Sample) and [f.seq for f in six] == list(range(len(s)))
+    np.testing.assert_array_equal([f.raw for f in six], s.raw)
+    np.testing.assert_array_equal([f.accel for f in six], s.accel)
+    np.testing.assert_array_equal([f.t_us for f in six], s.t_us)
+    assert frames[0].accel_sensitivity == 16384 and frames[-1] == fr.End(len(s))

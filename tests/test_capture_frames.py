@@ -1,4 +1,5 @@
-"""gyrocal frames: the C encoder against the Python decoder byte for byte, the CRC, and resynchronisation.
+"""gyrocal frames (gyro-only and 6-axis samples, device messages, the end of a session): the C encoder against
+the Python encoder and decoder byte for byte, the CRC, and resynchronisation.
 
 Independent references: the CRC-16/CCITT-FALSE check value 0x29B1 of b"123456789" (the
 published parameter catalogue of CRC-16 variants); the values fed to the encoders (what
@@ -35,18 +36,27 @@ def random_frames(rng, n=200):
         out.append(fr.Sample(int(rng.integers(0, 2**32)), int(rng.integers(0, 2**31)), raw, temp))
         w = tuple(float(np.float32(v)) for v in rng.normal(0, 100, 3))
         out.append(fr.Calibrated(i, int(rng.integers(0, 2**31)), w))
+        accel = tuple(int(v) for v in rng.integers(-32768, 32768, 3))
+        out.append(fr.ImuSample(int(rng.integers(0, 2**32)), int(rng.integers(0, 2**31)), raw, accel, temp))
     mean = tuple(float(np.float32(v)) for v in rng.normal(0, 5000, 3))
     out.append(fr.Turn(10, 1300, float(np.float32(52.6)), float(np.float32(358.2)), mean, 3, 0))
     out.append(fr.Result(0, "first-moment", 2, 6, (float(np.float32(0.0076)),) * 3, (float(np.float32(-12.5)),) * 3,
                          999))
     out.append(fr.Hello(200.0, 131.0, "deg/s", True, 0x0100, "gyrocal-example"))
+    out.append(fr.Hello(100.0, 131.0, "deg/s", False, 2, "imu", accel_sensitivity=16384))
     out.append(fr.Text("+x accepted"))
+    out.append(fr.End(int(rng.integers(0, 2**32))))
     return out
 
 
 def c_bytes(cdev: CDevice, f) -> bytes:
+    temp = -32768 if getattr(f, "temp", None) is None else round(f.temp * 100)
     if isinstance(f, fr.Sample):
-        return cdev.sample(f.seq, f.t_us, f.raw, -32768 if f.temp is None else round(f.temp * 100))
+        return cdev.sample(f.seq, f.t_us, f.raw, temp)
+    if isinstance(f, fr.ImuSample):
+        return cdev.imu(f.seq, f.t_us, f.raw, f.accel, temp)
+    if isinstance(f, fr.End):
+        return cdev.end(f.samples)
     if isinstance(f, fr.Calibrated):
         return cdev.calibrated(f.seq, f.t_us, f.w)
     if isinstance(f, fr.Turn):
@@ -54,7 +64,8 @@ def c_bytes(cdev: CDevice, f) -> bytes:
     if isinstance(f, fr.Result):
         return cdev.result(f.status, 0, f.iterations, f.n_turns, f.k, f.b, f.seq)
     if isinstance(f, fr.Hello):
-        return cdev.hello(f.sample_rate, f.sensitivity, has_temp=f.has_temp, firmware=f.firmware, library=f.library)
+        return cdev.hello(f.sample_rate, f.sensitivity, has_temp=f.has_temp, firmware=f.firmware, library=f.library,
+                          accel_sensitivity=f.accel_sensitivity or 0)
     return cdev.text(f.text)
 
 
@@ -79,6 +90,10 @@ def test_vectorised_sample_encoder_matches_one_by_one(rng):
     one = b"".join(fr.encode(fr.Sample(int(seq[i]), int(t[i]), tuple(map(int, raw[i])), float(temp[i])))
                    for i in range(n))
     assert fr.encode_samples(seq, t, raw, temp) == one
+    accel = rng.integers(-32768, 32768, (n, 3))
+    six = b"".join(fr.encode(fr.ImuSample(int(seq[i]), int(t[i]), tuple(map(int, raw[i])), tuple(map(int, accel[i])),
+                                          float(temp[i]))) for i in range(n))
+    assert fr.encode_samples(seq, t, raw, temp, accel) == six
 
 
 def test_text_frame_is_cut_at_the_payload_limit(cdev):
@@ -142,3 +157,30 @@ def test_device_clock_wrap_is_unwrapped():
     data = fr.encode_samples(np.arange(4), t, np.zeros((4, 3), int))
     got = fr.FrameDecoder().feed(data)
     assert np.all(np.diff([f.t_us for f in got]) == 5_000)
+
+
+@pytest.mark.parametrize("kind", ["drop", "corrupt"])
+def test_six_axis_frames_with_faults_lose_only_the_frames_hit(rng, kind):
+    """Damage in a stream of 6-axis frames: the frames that held a damaged byte are lost (a corrupted sync,
+    type or length byte hides its frame, any other fails the CRC); every other one decodes to what was sent."""
+    n = 300
+    raw, accel = rng.integers(-32768, 32768, (n, 3)), rng.integers(-32768, 32768, (n, 3))
+    data = fr.encode_samples(np.arange(n), 10_000 * np.arange(n), raw, None, accel)
+    size = len(data) // n
+    hit = np.sort(rng.choice(len(data), 20, replace=False))
+    buf = np.frombuffer(data, np.uint8).copy()
+    if kind == "drop":
+        damaged = np.delete(buf, hit).tobytes()
+    else:
+        buf[hit] ^= 0x10
+        damaged = buf.tobytes()
+    dec = fr.FrameDecoder()
+    got = dec.feed(damaged)
+    lost = set((hit // size).tolist())
+    assert [f.seq for f in got] == sorted(set(range(n)) - lost)
+    np.testing.assert_array_equal([f.accel for f in got], accel[[f.seq for f in got]])
+    np.testing.assert_array_equal([f.raw for f in got], raw[[f.seq for f in got]])
+    assert dec.stats.lost_samples == len([s for s in lost if s < max(f.seq for f in got)])
+    if kind == "corrupt":  # a flipped sync or length byte hides its frame; a flipped type (0x17, unknown) does not
+        hidden = {int(i // size) for i in hit if i % size in (0, 1, 3)}
+        assert dec.stats.crc_errors == len(lost - hidden)

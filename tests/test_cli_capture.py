@@ -194,9 +194,9 @@ def test_guide_without_a_sensitivity_is_refused_but_keeps_the_recording(tmp_path
 def test_simulate_device_serves_capture(tmp_path):
     """Two real processes, as a person would run them: the virtual device and the capture.
 
-    The device starts sending when it sees the port opened, so this test asserts only what
-    holds even if the capture missed the first bytes: a valid recording, the end of the
-    stream, and the device's calibration matching the host's recomputation.
+    The device repeats its hello until the capture has opened the port (pyserial empties the queue
+    on opening), then sends the session and its end frame, which says how many samples it sent:
+    the capture must have every one of them, the first ones included.
     """
     env = {**os.environ, "PYTHONUNBUFFERED": "1"}
     sim = subprocess.Popen([GYROCAL, "simulate", "--device", "--pace", "0", "--seed", "3", "--misalignment", "2"],
@@ -210,8 +210,9 @@ def test_simulate_device_serves_capture(tmp_path):
     finally:
         sim.kill()
     assert cap.returncode == 0 and sim.returncode == 0, (cap.stderr, sim_err)
-    assert "capture ended (end of stream)" in cap.stdout and "the device closed the link" in sim_out
+    assert "capture ended (end of session)" in cap.stdout and "the device closed the link" in sim_out
     assert "device and host agree to float32 precision" in cap.stdout
+    assert "link: nothing lost" in cap.stdout
     assert len(read_recording(tmp_path / "rec.csv", units="counts")) > 10_000
 
 
@@ -233,3 +234,49 @@ def test_capture_warns_when_the_device_result_is_off(tmp_path, servo):
         code, stdout, err = start(dev, "-o", tmp_path / "rec.csv").finish()
     assert code == 0 and "device and host DISAGREE" in stdout
     assert "warning: the device's calibration differs" in err
+
+
+def imu_z_scores(cal_path: Path, s) -> np.ndarray:
+    """(calibration file - simulator truth) / the file's own 1-sigma: accelerometer (9) and gyro (12) parameters."""
+    from gyrocal.files import load_calibration
+
+    cal = load_calibration(cal_path)
+    part = cal.accelerometer["parameters"]
+    xyz = "xyz".index
+    truth = [s.truth["accel_matrix"][xyz(n[2]), xyz(n[3])] if n[0] == "A" else s.truth["accel_offset"][xyz(n[2])]
+             for n in part["names"]]
+    std = [cal.accelerometer["std"][n] for n in part["names"]]
+    za = (np.array(part["values"]) - truth) / std
+    zg = (cal.model.params - s.model.params) / np.sqrt(np.diag(cal.covariance))
+    return np.r_[za, zg]
+
+
+def test_guided_multi_position_session_with_a_redo(tmp_path):
+    """The whole IMU through the example firmware's 6-axis frames: a person follows the guide, takes pose 4 back
+    (r + Enter) and holds it again; the calibration file (gyro and accelerometer) finds the simulator's truth
+    within 4 sigma of its own covariance."""
+    from gyrocal.capture.pose_guide import guided_directions
+    from gyrocal.capture.simulated_imu import simulate_device_imu_session
+
+    d = guided_directions(12)
+    s = simulate_device_imu_session([*d[:4], d[3], *d[4:]], rng=np.random.default_rng(1603), aim_deg=1.5)
+    data = device_bytes(s, "frames", encoder="c")
+    k = s.windows[3].start + int(2.5 * s.sample_rate)  # 2.5 s into pose 4: accepted by then, still held
+    at = data.index(fr.encode(fr.ImuSample(k, int(s.t_us[k]), tuple(s.raw[k]), tuple(s.accel[k]), float(s.temp[k]))))
+    out = tmp_path / "imu.csv"
+    with VirtualDevice(data, faults=Faults(stall_at=at / len(data), stall_s=WAIT)) as dev:
+        run = start(dev, "-o", out, "--guide", "multi-position")
+        run.wait_for("ok: pose 4: accepted")
+        run.proc.stdin.write("r\n")
+        run.proc.stdin.flush()
+        run.wait_for("redo pose 4")
+        dev.resume()
+        code, stdout, err = run.finish()
+    assert code == 0, err
+    accepted = [ln.split(": ")[2] for ln in stdout.splitlines() if ln.startswith("guide: ok:")]
+    assert accepted == [f"pose {i}" for i in (1, 2, 3, 4, 4, *range(5, 13))]
+    assert "enough poses, covering the sphere" in stdout and "accelerometer:" in stdout
+    rec = read_recording(out, units="counts", accel_units="counts")
+    np.testing.assert_array_equal(rec.accel, s.accel[: len(rec)])  # ax, ay, az as the device sent them
+    z = imu_z_scores(out.with_suffix(".cal.json"), s)
+    assert np.all(np.abs(z) <= 4), z

@@ -12,10 +12,11 @@
 extern "C" {
 #endif
 
-/* Wait until the next sample is due, then read the gyro [counts] and its temperature [0.01 degC]
- * (GYROCAL_TEMP_NONE without one). Returns 0, or non-zero when there are no more samples
- * (a host test's simulated session ends; real boards never end). */
-int board_read_gyro(int16_t raw[3], int16_t *temp_centi);
+/* Wait until the next sample is due, then read the gyro and the accelerometer [counts] and the
+ * temperature [0.01 degC] (GYROCAL_TEMP_NONE without one). A board without an accelerometer leaves
+ * accel alone (the firmware sends it only when set up with an accelerometer sensitivity). Returns 0,
+ * or non-zero when there are no more samples (a host test's simulated session ends; real boards never end). */
+int board_read(int16_t gyro[3], int16_t accel[3], int16_t *temp_centi);
 /* Send n bytes to the host (a UART, USB CDC); may block while the transmit buffer is full. */
 void board_write(const uint8_t *data, size_t n);
 /* Free-running clocks since power-up [us] and [ms], wrapping at 2^32. */

@@ -20,19 +20,21 @@ static void send_text(example_t *ex, const char *a, const char *b)
     board_write(ex->frame, gyrocal_frame_text(ex->frame, text));
 }
 
-void example_setup(example_t *ex, float sample_rate, float sensitivity, int has_temp)
+void example_setup(example_t *ex, float sample_rate, float sensitivity, uint16_t accel_sensitivity, int has_temp)
 {
     static const char name[] = EXAMPLE_FIRMWARE;
     gyrocal_hello_t hello;
     size_t i;
     gyrocal_session_init(&ex->session, sample_rate, sensitivity, 360.0f);
     ex->calibrated = 0;
+    ex->send_accel = accel_sensitivity != 0u;
     ex->seq = 0u;
     hello.sample_rate = sample_rate;
     hello.sensitivity = sensitivity;
     hello.rate_unit = GYROCAL_UNIT_DEG_S;
-    hello.flags = has_temp ? GYROCAL_HELLO_HAS_TEMP : 0u;
+    hello.flags = (uint8_t)((has_temp ? GYROCAL_HELLO_HAS_TEMP : 0u) | (ex->send_accel ? GYROCAL_HELLO_HAS_ACCEL : 0u));
     hello.library = GYROCAL_CAL_VERSION;
+    hello.accel_sensitivity = accel_sensitivity;
     for (i = 0; i < sizeof hello.firmware; ++i) {
         hello.firmware[i] = i < sizeof name - 1u ? name[i] : '\0';
     }
@@ -62,14 +64,16 @@ static void report(example_t *ex, unsigned events)
 
 int example_step(example_t *ex)
 {
-    int16_t raw[3], temp = GYROCAL_TEMP_NONE;
+    int16_t raw[3], accel[3] = {0, 0, 0}, temp = GYROCAL_TEMP_NONE;
     uint32_t t_us;
     unsigned events;
-    if (board_read_gyro(raw, &temp) != 0) {
+    if (board_read(raw, accel, &temp) != 0) {
+        board_write(ex->frame, gyrocal_frame_end(ex->frame, ex->seq));
         return 1;
     }
     t_us = board_micros();
-    board_write(ex->frame, gyrocal_frame_sample(ex->frame, ex->seq, t_us, raw, temp));
+    board_write(ex->frame, ex->send_accel ? gyrocal_frame_imu(ex->frame, ex->seq, t_us, raw, accel, temp)
+                                          : gyrocal_frame_sample(ex->frame, ex->seq, t_us, raw, temp));
     events = gyrocal_session_add(&ex->session, raw);
     if (events) {
         report(ex, events);

@@ -1,9 +1,10 @@
 /*
  * gyrocal_example.h: example firmware for `gyrocal capture` (part of gyrocal, MIT licence).
  *
- * Streams every sample as a gyrocal frame, runs the six-turn calibration of the servo method of
- * Wang et al. on the device (gyrocal_session), reports each turn and its result, and from then on
- * also sends the corrected samples. Portable C99: the board layer (board.h) is the only port.
+ * Streams every sample as a gyrocal frame (gyro only, or 6-axis with the accelerometer for the
+ * multi-position hand session), runs the six-turn calibration of the servo method of Wang et al. on
+ * the device (gyrocal_session), reports each turn and its result, and from then on also sends the
+ * corrected samples. Portable C99: the board layer (board.h) is the only port.
  */
 #ifndef GYROCAL_EXAMPLE_H
 #define GYROCAL_EXAMPLE_H
@@ -29,13 +30,16 @@ typedef struct {
     gyrocal_session_t session;
     gyrocal_affine_t cal; /* the device's correction once calibrated */
     int calibrated;
+    int send_accel; /* 6-axis frames (GYROCAL_FRAME_IMU) instead of sample frames */
     uint32_t seq;
     uint8_t frame[GYROCAL_FRAME_MAX];
 } example_t;
 
-/* Start: set up the session and send the hello frame. sample_rate [Hz], sensitivity [counts per deg/s]. */
-void example_setup(example_t *ex, float sample_rate, float sensitivity, int has_temp);
-/* One sample: read, send, calibrate. Returns 0, or non-zero when the board has no more samples. */
+/* Start: set up the session and send the hello frame. sample_rate [Hz], sensitivity [counts per deg/s];
+ * accel_sensitivity [counts per g] sends 6-axis frames with the accelerometer (0: gyro only). */
+void example_setup(example_t *ex, float sample_rate, float sensitivity, uint16_t accel_sensitivity, int has_temp);
+/* One sample: read, send, calibrate. Returns 0, or non-zero when the board has no more samples (then it
+ * has sent the end frame). */
 int example_step(example_t *ex);
 
 #ifdef __cplusplus

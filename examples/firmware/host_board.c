@@ -6,20 +6,24 @@
 #include "board.h"
 #include "gyrocal_example.h"
 
-static const int16_t *g_raw, *g_temp;
+static const int16_t *g_raw, *g_accel, *g_temp;
 static const uint32_t *g_t_us;
 static uint32_t g_n, g_i;
 static uint8_t *g_out;
 static size_t g_cap, g_len, g_dropped;
 
-int board_read_gyro(int16_t raw[3], int16_t *temp_centi)
+int board_read(int16_t raw[3], int16_t accel[3], int16_t *temp_centi)
 {
+    int i;
     if (g_i >= g_n) {
         return 1;
     }
-    raw[0] = g_raw[3 * g_i];
-    raw[1] = g_raw[3 * g_i + 1];
-    raw[2] = g_raw[3 * g_i + 2];
+    for (i = 0; i < 3; ++i) {
+        raw[i] = g_raw[3 * g_i + i];
+        if (g_accel) {
+            accel[i] = g_accel[3 * g_i + i];
+        }
+    }
     *temp_centi = g_temp ? g_temp[g_i] : GYROCAL_TEMP_NONE;
     ++g_i;
     return 0;
@@ -47,12 +51,14 @@ uint32_t board_millis(void)
     return board_micros() / 1000u;
 }
 
-/* Run the example firmware over n samples; returns the bytes sent, or 0 if `out` was too small. */
-size_t example_run(const int16_t *raw, const uint32_t *t_us, const int16_t *temp, uint32_t n, float sample_rate,
-                   float sensitivity, uint8_t *out, size_t cap)
+/* Run the example firmware over n samples (accel may be NULL: gyro only); returns the bytes sent, or 0 if
+ * `out` was too small. */
+size_t example_run(const int16_t *raw, const int16_t *accel, const uint32_t *t_us, const int16_t *temp, uint32_t n,
+                   float sample_rate, float sensitivity, uint16_t accel_sensitivity, uint8_t *out, size_t cap)
 {
     static example_t ex;
     g_raw = raw;
+    g_accel = accel;
     g_t_us = t_us;
     g_temp = temp;
     g_n = n;
@@ -60,7 +66,7 @@ size_t example_run(const int16_t *raw, const uint32_t *t_us, const int16_t *temp
     g_out = out;
     g_cap = cap;
     g_len = g_dropped = 0u;
-    example_setup(&ex, sample_rate, sensitivity, temp != 0);
+    example_setup(&ex, sample_rate, sensitivity, accel ? accel_sensitivity : 0u, temp != 0);
     while (example_step(&ex) == 0) {
     }
     return g_dropped ? 0u : g_len;

@@ -34,7 +34,7 @@ static float noise(void) /* xorshift32; sum of four uniforms: zero mean, std 0.6
     return (s - 2.0f) * 1.7320508f * 0.6f;
 }
 
-int board_read_gyro(int16_t raw[3], int16_t *temp_centi)
+int board_read(int16_t raw[3], int16_t accel[3], int16_t *temp_centi)
 {
     uint32_t i = n_sample, period = TURN_N + WAIT_N, turn;
     float w[3] = {0.0f, 0.0f, 0.0f};
@@ -49,6 +49,8 @@ int board_read_gyro(int16_t raw[3], int16_t *temp_centi)
         float counts = (w[a] / K_TRUE[a] - B_TRUE[a] + noise()) * SENS;
         raw[a] = (int16_t)(counts < 0.0f ? counts - 0.5f : counts + 0.5f);
     }
+    accel[0] = accel[1] = 0; /* flat on a table: 1 g on z (16384 counts per g), sent only in 6-axis mode */
+    accel[2] = 16384;
     *temp_centi = 2500;
     ++n_sample;
     return 0;
@@ -80,7 +82,7 @@ uint32_t board_millis(void)
 int main(void)
 {
     static example_t ex;
-    example_setup(&ex, FS, SENS, 1);
+    example_setup(&ex, FS, SENS, 0u, 1);
     while (example_step(&ex) == 0) {
     }
     return 0;

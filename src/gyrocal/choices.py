@@ -58,8 +58,9 @@ StudyName = Literal["servo-normal", "servo-extreme", "servo-speed", "servo-conve
 CaptureWire = Literal["auto", "frames", "text"]
 #: Wire formats the virtual device sends (``gyrocal simulate --device``).
 DeviceWire = Literal["frames", "text"]
-#: Guided sessions of ``gyrocal capture --guide`` (see :mod:`gyrocal.capture.guide`).
-GuideName = Literal["servo", "hand"]
+#: Guided sessions of ``gyrocal capture --guide`` (see :mod:`gyrocal.capture.guide` and
+#: :mod:`gyrocal.capture.pose_guide`).
+GuideName = Literal["servo", "hand", "multi-position"]
 #: Experimental designs of the planner (see :mod:`gyrocal.planning`).
 DesignName = Literal["six", "six-static", "twelve"]
 #: Designs ``gyrocal plan`` predicts: the servo designs, and a hand session of still poses (see

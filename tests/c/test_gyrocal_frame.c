@@ -3,7 +3,7 @@
  * tests/test_c_native.py with -fsanitize=address,undefined.
  *
  * References: the CRC-16/CCITT-FALSE check value 0x29B1 of "123456789" (the CRC catalogue's), a sample
- * frame written out by hand from docs/capture.md's byte table, and a noise-free six-turn session built
+ * frame, a 6-axis (IMU) frame and an end frame written out by hand from docs/capture.md's byte tables, and a noise-free six-turn session built
  * from a known k and b, which the session must find to float32 precision.
  * Exit status: the number of failed checks (0 = all passed).
  */
@@ -41,6 +41,29 @@ static void test_crc_and_sample_frame(void)
     memcpy(head + 2, payload, 16);
     crc = gyrocal_crc16(head, sizeof head, 0xFFFFu);
     CHECK(out[20] == (crc & 0xFFu) && out[21] == (crc >> 8));
+}
+
+static void test_imu_and_end_frames(void)
+{
+    /* seq 2, t 10000 us, gyro (1, -2, 300), accel (-16384, 0, 8192), no temperature */
+    static const uint8_t payload[22] = {2, 0, 0, 0, 0x10, 0x27, 0, 0, 1, 0, 0xFE, 0xFF, 0x2C, 0x01,
+                                        0x00, 0xC0, 0, 0, 0x00, 0x20, 0x00, 0x80};
+    static const uint8_t end[4] = {0x39, 0x30, 0, 0}; /* 12345 samples */
+    const int16_t gyro[3] = {1, -2, 300}, accel[3] = {-16384, 0, 8192};
+    uint8_t out[GYROCAL_FRAME_MAX], head[2 + 22];
+    uint16_t crc;
+    CHECK(gyrocal_frame_imu(out, 2u, 10000u, gyro, accel, GYROCAL_TEMP_NONE) == GYROCAL_FRAME_IMU_SIZE);
+    CHECK(out[0] == 0xA5u && out[1] == 0x5Au && out[2] == GYROCAL_FRAME_IMU && out[3] == 22u);
+    CHECK(memcmp(out + 4, payload, 22) == 0);
+    head[0] = GYROCAL_FRAME_IMU;
+    head[1] = 22u;
+    memcpy(head + 2, payload, 22);
+    crc = gyrocal_crc16(head, sizeof head, 0xFFFFu);
+    CHECK(out[26] == (crc & 0xFFu) && out[27] == (crc >> 8));
+    CHECK(gyrocal_frame_end(out, 12345u) == GYROCAL_FRAME_OVERHEAD + 4u);
+    CHECK(out[2] == GYROCAL_FRAME_END && out[3] == 4u && memcmp(out + 4, end, 4) == 0);
+    CHECK(gyrocal_frame_imu(out, 0u, 0u, gyro, 0, 0) == 0u && gyrocal_frame_imu(out, 0u, 0u, 0, accel, 0) == 0u);
+    CHECK(gyrocal_frame_imu(0, 0u, 0u, gyro, accel, 0) == 0u && gyrocal_frame_end(0, 1u) == 0u);
 }
 
 static void test_null_and_limits(void)
@@ -103,6 +126,7 @@ static void test_session_finds_the_six_turns(void)
 int main(void)
 {
     test_crc_and_sample_frame();
+    test_imu_and_end_frames();
     test_null_and_limits();
     test_session_finds_the_six_turns();
     return failures;

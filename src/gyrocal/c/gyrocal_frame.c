@@ -82,7 +82,7 @@ size_t gyrocal_frame_hello(uint8_t out[GYROCAL_FRAME_MAX], const gyrocal_hello_t
     p = put_f32(p, hello->sample_rate);
     p = put_f32(p, hello->sensitivity);
     p = put_u16(p, hello->library);
-    p = put_u16(p, 0u);
+    p = put_u16(p, hello->accel_sensitivity);
     for (i = 0; i < 16; ++i) {
         *p++ = (uint8_t)hello->firmware[i];
     }
@@ -104,6 +104,26 @@ size_t gyrocal_frame_sample(uint8_t out[GYROCAL_FRAME_MAX], uint32_t seq, uint32
     }
     put_u16(p, (uint16_t)temp_centi);
     return gyrocal_frame(out, GYROCAL_FRAME_SAMPLE, out + 4, GYROCAL_FRAME_SAMPLE_LEN);
+}
+
+size_t gyrocal_frame_imu(uint8_t out[GYROCAL_FRAME_MAX], uint32_t seq, uint32_t t_us, const int16_t gyro[3],
+                         const int16_t accel[3], int16_t temp_centi)
+{
+    uint8_t *p;
+    int i;
+    if (out == 0 || gyro == 0 || accel == 0) {
+        return 0u;
+    }
+    p = put_u32(out + 4, seq);
+    p = put_u32(p, t_us);
+    for (i = 0; i < 3; ++i) {
+        p = put_u16(p, (uint16_t)gyro[i]);
+    }
+    for (i = 0; i < 3; ++i) {
+        p = put_u16(p, (uint16_t)accel[i]);
+    }
+    put_u16(p, (uint16_t)temp_centi);
+    return gyrocal_frame(out, GYROCAL_FRAME_IMU, out + 4, GYROCAL_FRAME_IMU_LEN);
 }
 
 size_t gyrocal_frame_calibrated(uint8_t out[GYROCAL_FRAME_MAX], uint32_t seq, uint32_t t_us, const float w[3])
@@ -175,4 +195,13 @@ size_t gyrocal_frame_text(uint8_t out[GYROCAL_FRAME_MAX], const char *text)
         ++n;
     }
     return gyrocal_frame(out, GYROCAL_FRAME_TEXT, out + 4, n);
+}
+
+size_t gyrocal_frame_end(uint8_t out[GYROCAL_FRAME_MAX], uint32_t n_samples)
+{
+    if (out == 0) {
+        return 0u;
+    }
+    put_u32(out + 4, n_samples);
+    return gyrocal_frame(out, GYROCAL_FRAME_END, out + 4, GYROCAL_FRAME_END_LEN);
 }

@@ -38,18 +38,24 @@ extern "C" {
 #define GYROCAL_FRAME_TURN 0x04u        /* one turn the device saw, accepted or not */
 #define GYROCAL_FRAME_RESULT 0x05u      /* the device's own calibration */
 #define GYROCAL_FRAME_TEXT 0x06u        /* a message for the person at the host, UTF-8 */
+#define GYROCAL_FRAME_IMU 0x07u         /* one raw 6-axis sample: gyro and accelerometer counts, stamp, temperature */
+#define GYROCAL_FRAME_END 0x08u         /* the session is over: the device sends nothing more */
 #define GYROCAL_FRAME_HELLO_LEN 32u
 #define GYROCAL_FRAME_SAMPLE_LEN 16u
 #define GYROCAL_FRAME_CALIBRATED_LEN 20u
 #define GYROCAL_FRAME_TURN_LEN 32u
 #define GYROCAL_FRAME_RESULT_LEN 32u
+#define GYROCAL_FRAME_IMU_LEN 22u
+#define GYROCAL_FRAME_END_LEN 4u
 #define GYROCAL_FRAME_SAMPLE_SIZE (GYROCAL_FRAME_OVERHEAD + GYROCAL_FRAME_SAMPLE_LEN)
+#define GYROCAL_FRAME_IMU_SIZE (GYROCAL_FRAME_OVERHEAD + GYROCAL_FRAME_IMU_LEN)
 
 /* Units of rates in hello, turn, result and calibrated frames. */
 #define GYROCAL_UNIT_RAD_S 0u
 #define GYROCAL_UNIT_DEG_S 1u
 /* Hello flags. */
 #define GYROCAL_HELLO_HAS_TEMP 1u
+#define GYROCAL_HELLO_HAS_ACCEL 2u /* samples come as GYROCAL_FRAME_IMU, with the accelerometer */
 /* Temperature field of a sample frame when the device has no thermometer. */
 #define GYROCAL_TEMP_NONE INT16_MIN
 /* Result methods. */
@@ -63,6 +69,7 @@ typedef struct {
     uint8_t flags;      /* GYROCAL_HELLO_* */
     uint16_t library;   /* GYROCAL_CAL_VERSION of the gyrocal C library the firmware was built with */
     char firmware[16];  /* firmware name and version, NUL-padded (need not be terminated) */
+    uint16_t accel_sensitivity; /* accelerometer counts per g (16384 for an MPU-6050 at +-2 g); 0 without one */
 } gyrocal_hello_t;
 
 /* Slots of the six turns, in the servo method's order (+x, -x, +y, -y, +z, -z). */
@@ -91,6 +98,9 @@ size_t gyrocal_frame_hello(uint8_t out[GYROCAL_FRAME_MAX], const gyrocal_hello_t
 /* temp_centi: temperature [0.01 degC], or GYROCAL_TEMP_NONE. */
 size_t gyrocal_frame_sample(uint8_t out[GYROCAL_FRAME_MAX], uint32_t seq, uint32_t t_us, const int16_t raw[3],
                             int16_t temp_centi);
+/* gyro, accel: [counts]; temp_centi as for a sample frame. */
+size_t gyrocal_frame_imu(uint8_t out[GYROCAL_FRAME_MAX], uint32_t seq, uint32_t t_us, const int16_t gyro[3],
+                         const int16_t accel[3], int16_t temp_centi);
 size_t gyrocal_frame_calibrated(uint8_t out[GYROCAL_FRAME_MAX], uint32_t seq, uint32_t t_us, const float w[3]);
 size_t gyrocal_frame_turn(uint8_t out[GYROCAL_FRAME_MAX], const gyrocal_turn_t *turn);
 /* The device's calibration: status, method, iterations, turns used, k [rate unit per count], b [counts],
@@ -99,6 +109,9 @@ size_t gyrocal_frame_result(uint8_t out[GYROCAL_FRAME_MAX], gyrocal_status_t sta
                             uint8_t iterations, uint8_t n_turns, const gyrocal_scale_bias_t *sb, uint32_t seq);
 /* A NUL-terminated message, cut at GYROCAL_FRAME_MAX_PAYLOAD bytes. */
 size_t gyrocal_frame_text(uint8_t out[GYROCAL_FRAME_MAX], const char *text);
+/* The end of the session (a recorded or simulated one; a live board never ends): n_samples sample or IMU
+ * frames were sent in all. The host knows it has everything once it has read this frame. */
+size_t gyrocal_frame_end(uint8_t out[GYROCAL_FRAME_MAX], uint32_t n_samples);
 
 #ifdef __cplusplus
 }

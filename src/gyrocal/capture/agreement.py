@@ -29,7 +29,8 @@ from ..estimators import FirstMoment
 from ..observations import ObservationSet
 from .frames import TURN_LABELS, Result, Turn
 
-__all__ = ["C_ROUND", "EPS32", "Agreement", "accumulator_bound", "check_device", "solution_bound"]
+__all__ = ["C_ROUND", "EPS32", "Agreement", "CorrectedCheck", "accumulator_bound", "check_device", "corrected_bound",
+           "solution_bound"]
 
 EPS32 = float(np.finfo(np.float32).eps)
 C_ROUND = 32.0
@@ -120,8 +121,30 @@ def corrected_bound(k, b, raw) -> np.ndarray:
     return C_ROUND * EPS32 * k * (np.abs(raw) + b)
 
 
+class CorrectedCheck:
+    """Corrected samples checked as they come (step 3 of the module notes), keeping only the worst ratio.
+
+    Parameters
+    ----------
+    k, b : array_like (3,)
+        The device's result the samples were corrected with [rate unit per count], [counts].
+    """
+
+    def __init__(self, k, b):
+        self.k, self.b = np.asarray(k, float), np.asarray(b, float)
+        self.ratio, self.n = 0.0, 0
+
+    def add(self, raw, w) -> None:
+        """Raw samples (n, 3) [counts] and the corrected samples (n, 3) the device sent for them."""
+        raw, w = np.asarray(raw, float).reshape(-1, 3), np.asarray(w, float).reshape(-1, 3)
+        if len(raw):
+            err = np.abs(w - self.k * (raw + self.b)) / corrected_bound(self.k, self.b, raw)
+            self.ratio = max(self.ratio, float(np.max(err)))
+            self.n += len(raw)
+
+
 def check_device(turns: dict[int, Turn], result: Result, samples: dict[int, np.ndarray] | None = None,
-                 corrected: tuple[np.ndarray, np.ndarray] | None = None) -> Agreement:
+                 corrected: tuple[np.ndarray, np.ndarray] | CorrectedCheck | None = None) -> Agreement:
     """Recompute the device's calibration on the host (see the module notes).
 
     Parameters
@@ -133,8 +156,9 @@ def check_device(turns: dict[int, Turn], result: Result, samples: dict[int, np.n
     samples : dict of int to ndarray, optional
         Slot -> the raw samples (n, 3) [counts] of that turn as the host recorded them, when the
         host has every one of them.
-    corrected : (ndarray, ndarray), optional
-        Raw samples (n, 3) [counts] and the corrected samples (n, 3) the device sent for them.
+    corrected : (ndarray, ndarray) or CorrectedCheck, optional
+        Raw samples (n, 3) [counts] and the corrected samples (n, 3) the device sent for them, or
+        those already checked as they came.
     """
     slots = range(len(TURN_LABELS))
     mean = np.array([turns[s].mean for s in slots], dtype=float)
@@ -153,11 +177,10 @@ def check_device(turns: dict[int, Turn], result: Result, samples: dict[int, np.n
             continue
         tol, _ = accumulator_bound(x)
         means_ratio = max(means_ratio, float(np.max(np.abs(mean[s] - x.mean(axis=0)) / tol)))
-    corrected_ratio, corrected_n = 0.0, 0
-    if corrected is not None and len(corrected[0]):
-        raw, w = (np.asarray(a, float) for a in corrected)
-        k, b = np.asarray(result.k, float), np.asarray(result.b, float)
-        corrected_ratio = float(np.max(np.abs(w - k * (raw + b)) / corrected_bound(k, b, raw)))
-        corrected_n = len(raw)
+    if corrected is not None and not isinstance(corrected, CorrectedCheck):
+        raw, w = corrected
+        corrected = CorrectedCheck(result.k, result.b)
+        corrected.add(raw, w)
+    ratio, n = (0.0, 0) if corrected is None else (corrected.ratio, corrected.n)
     return Agreement(np.array(result.k), np.array(result.b), fit.model.k, fit.model.b, params_ratio, means_ratio,
-                     tuple(missing), corrected_ratio, corrected_n)
+                     tuple(missing), ratio, n)

@@ -2,9 +2,10 @@
 
 :func:`firmware_stream` sends a session through the same calls, in the same order, as the
 example firmware (``examples/firmware/gyrocal_example.c``): a hello frame, then per sample a
-sample frame, the session's turn and result frames with a text line each, and corrected
-samples once calibrated. The virtual device serves these bytes, and a test checks them
-byte for byte against the example firmware compiled on the host.
+sample frame (or a 6-axis frame), the session's turn and result frames with a text line each,
+corrected samples once calibrated, and an end frame when the session is over. The virtual
+device serves these bytes, and a test checks them byte for byte against the example firmware
+compiled on the host.
 """
 
 from __future__ import annotations
@@ -26,7 +27,8 @@ _REASONS = (" accepted", " ignored: wrong angle", " ignored: off axis", " ignore
 
 class _Hello(ctypes.Structure):
     _fields_ = [("sample_rate", ctypes.c_float), ("sensitivity", ctypes.c_float), ("rate_unit", ctypes.c_uint8),
-                ("flags", ctypes.c_uint8), ("library", ctypes.c_uint16), ("firmware", ctypes.c_char * 16)]
+                ("flags", ctypes.c_uint8), ("library", ctypes.c_uint16), ("firmware", ctypes.c_char * 16),
+                ("accel_sensitivity", ctypes.c_uint16)]
 
 
 class _Turn(ctypes.Structure):
@@ -67,6 +69,9 @@ _SIGNATURES = {
     "gyrocal_frame_hello": (ctypes.c_size_t, [_U8P, _P(_Hello)]),
     "gyrocal_frame_sample": (ctypes.c_size_t, [_U8P, ctypes.c_uint32, ctypes.c_uint32, _P(ctypes.c_int16),
                                                ctypes.c_int16]),
+    "gyrocal_frame_imu": (ctypes.c_size_t, [_U8P, ctypes.c_uint32, ctypes.c_uint32, _P(ctypes.c_int16),
+                                            _P(ctypes.c_int16), ctypes.c_int16]),
+    "gyrocal_frame_end": (ctypes.c_size_t, [_U8P, ctypes.c_uint32]),
     "gyrocal_frame_calibrated": (ctypes.c_size_t, [_U8P, ctypes.c_uint32, ctypes.c_uint32, _P(ctypes.c_float)]),
     "gyrocal_frame_turn": (ctypes.c_size_t, [_U8P, _P(_Turn)]),
     "gyrocal_frame_result": (ctypes.c_size_t, [_U8P, ctypes.c_int, ctypes.c_uint8, ctypes.c_uint8, ctypes.c_uint8,
@@ -98,13 +103,21 @@ class CDevice:
         return self.dll.gyrocal_crc16(arr, len(data), 0xFFFF)
 
     def hello(self, sample_rate: float, sensitivity: float, *, has_temp: bool, firmware: str,
-              library: int = C_LIBRARY_VERSION, rate_unit: int = 1) -> bytes:
-        h = _Hello(sample_rate, sensitivity, rate_unit, int(has_temp), library, firmware.encode()[:16])
+              library: int = C_LIBRARY_VERSION, rate_unit: int = 1, accel_sensitivity: int = 0) -> bytes:
+        flags = int(has_temp) | (2 if accel_sensitivity else 0)  # GYROCAL_HELLO_HAS_TEMP, _HAS_ACCEL
+        h = _Hello(sample_rate, sensitivity, rate_unit, flags, library, firmware.encode()[:16], accel_sensitivity)
         return self._out(self.dll.gyrocal_frame_hello(self._buf, ctypes.byref(h)))
 
     def sample(self, seq: int, t_us: int, raw, temp_centi: int) -> bytes:
         r = (ctypes.c_int16 * 3)(*(int(v) for v in raw))
         return self._out(self.dll.gyrocal_frame_sample(self._buf, seq & 0xFFFFFFFF, t_us & 0xFFFFFFFF, r, temp_centi))
+
+    def imu(self, seq: int, t_us: int, raw, accel, temp_centi: int) -> bytes:
+        r, a = ((ctypes.c_int16 * 3)(*(int(v) for v in x)) for x in (raw, accel))
+        return self._out(self.dll.gyrocal_frame_imu(self._buf, seq & 0xFFFFFFFF, t_us & 0xFFFFFFFF, r, a, temp_centi))
+
+    def end(self, n_samples: int) -> bytes:
+        return self._out(self.dll.gyrocal_frame_end(self._buf, n_samples & 0xFFFFFFFF))
 
     def calibrated(self, seq: int, t_us: int, w) -> bytes:
         return self._out(self.dll.gyrocal_frame_calibrated(self._buf, seq, t_us & 0xFFFFFFFF, _F3(*w)))
@@ -133,11 +146,15 @@ class CDevice:
         return out
 
     def firmware_stream(self, raw, t_us, temp=None, *, sample_rate: float, sensitivity: float,
-                        firmware: str = "gyrocal-example", send_calibrated: bool = True) -> bytes:
-        """Every byte the example firmware sends for this session (see the module notes)."""
+                        firmware: str = "gyrocal-example", send_calibrated: bool = True, accel=None,
+                        accel_sensitivity: int = 0) -> bytes:
+        """Every byte the example firmware sends for this session (see the module notes); with `accel`
+        [counts] and its `accel_sensitivity` [counts per g], 6-axis frames instead of sample frames."""
         raw = np.asarray(raw, dtype=np.int16)
+        acc = None if accel is None else np.asarray(accel, dtype=np.int16)
         temp_c = None if temp is None else np.round(np.asarray(temp, dtype=float) * 100).astype(np.int16)
-        parts = [self.hello(sample_rate, sensitivity, has_temp=temp is not None, firmware=firmware)]
+        parts = [self.hello(sample_rate, sensitivity, has_temp=temp is not None, firmware=firmware,
+                            accel_sensitivity=accel_sensitivity if acc is not None else 0)]
         s = _Session()
         self.dll.gyrocal_session_init(ctypes.byref(s), sample_rate, sensitivity, 360.0)
         cal = (ctypes.c_float * 12)()
@@ -147,7 +164,8 @@ class CDevice:
         for i in range(len(raw)):
             r[0], r[1], r[2] = (int(v) for v in raw[i])
             t = int(t_us[i])
-            parts.append(self.sample(i, t, r, -32768 if temp_c is None else int(temp_c[i])))
+            tc = -32768 if temp_c is None else int(temp_c[i])
+            parts.append(self.sample(i, t, r, tc) if acc is None else self.imu(i, t, r, acc[i], tc))
             events = self.dll.gyrocal_session_add(ctypes.byref(s), r)
             if events:
                 parts.append(self._events(s, events))
@@ -158,6 +176,7 @@ class CDevice:
                 x[0], x[1], x[2] = r[0], r[1], r[2]
                 self.dll.gyrocal_correct(cal, x, w)
                 parts.append(self.calibrated(i, t, w))
+        parts.append(self.end(len(raw)))
         return b"".join(parts)
 
 

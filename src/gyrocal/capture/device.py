@@ -3,8 +3,20 @@
 ``gyrocal capture`` reads it like a board on a USB serial port: the pseudo-terminal is put in
 raw mode, so every byte passes unchanged. Faults on request: dropped bytes, corrupted bytes
 (CRC errors), a stall (the device stops sending for a while, then goes on) and a disconnect
-(the link is cut part way). Before it closes the link, the device waits until the reader has
-taken every byte already sent, so "what was sent before the cut" is exact.
+(the link is cut part way).
+
+Closing a pseudo-terminal discards what the reader has not read yet, so the device closes the
+link only when nothing can be lost. A session that ends with the end-of-session marker (an end
+frame, or the text line ``# end of session``) is over when the reader, having read the marker,
+closes the port: the device waits for that hang-up. A stream cut short (the disconnect fault,
+or data without the marker) has no marker to wait for; there the device waits until the
+reader's input queue has stayed empty for a while (the kernel hands written bytes to that
+queue a little later), which is exact on an idle machine and very likely on a loaded one.
+
+pyserial empties the input queue when it opens a port, so a device that starts before the
+reader would lose its first bytes. Tests start the device once the reader has the port open
+(:meth:`VirtualDevice.release`); for people (``gyrocal simulate --device``) the device repeats
+its hello until it sees the reader take bytes or empty the queue, and only then starts.
 """
 
 from __future__ import annotations
@@ -25,10 +37,11 @@ from typing import Literal, Self
 import numpy as np
 
 from ..errors import InputError
-from .frames import Hello, encode, encode_samples
+from .frames import End, FrameDecoder, Hello, encode, encode_samples
 from .simulated import DeviceSession
+from .text import END_LINE
 
-__all__ = ["Faults", "VirtualDevice", "damage", "device_bytes", "parse_faults", "text_lines"]
+__all__ = ["Faults", "VirtualDevice", "damage", "device_bytes", "parse_faults", "preamble", "text_lines"]
 
 Wire = Literal["frames", "text"]
 
@@ -114,31 +127,53 @@ def damage(data: bytes, faults: Faults) -> tuple[bytes, Damage]:
 
 
 def text_lines(session: DeviceSession) -> bytes:
-    """The session as an Arduino sketch prints it with ``Serial.println``: ``t_us,gx,gy,gz[,temp]``."""
+    """The session as an Arduino sketch prints it with ``Serial.println``: ``t_us,gx,gy,gz[,temp][,ax,ay,az]``,
+    then the end-of-session line."""
     head = "t_us,gx,gy,gz" + (",temp" if session.temp is not None else "")
     cols = [session.t_us.astype(str), *(session.raw[:, j].astype(str) for j in range(3))]
     if session.temp is not None:
         cols.append(np.char.mod("%.2f", session.temp))
+    if session.accel is not None:
+        head += ",ax,ay,az"
+        cols += [session.accel[:, j].astype(str) for j in range(3)]
     rows = cols[0]
     for c in cols[1:]:
         rows = np.char.add(np.char.add(rows, ","), c)
-    return (head + "\r\n" + "\r\n".join(rows.tolist()) + "\r\n").encode()
+    return (head + "\r\n" + "\r\n".join(rows.tolist()) + "\r\n" + END_LINE + "\r\n").encode()
 
 
 def device_bytes(session: DeviceSession, wire: Wire = "frames", encoder: Literal["c", "python"] = "c") -> bytes:
     """What a device sends for `session`: text lines, or gyrocal frames from the C library (the example
-    firmware: samples, turns, its own calibration and corrected samples) or from Python (samples only)."""
+    firmware: samples, turns, its own calibration and corrected samples) or from Python (samples only);
+    6-axis frames when the session has an accelerometer. Every stream ends with the end-of-session marker."""
     if wire == "text":
         return text_lines(session)
     if wire != "frames":
         raise InputError(f"{{param}} must be 'frames' or 'text', got {wire!r}", param="wire", value=wire)
+    accel_sens = int(session.accel_sensitivity or 0)
     if encoder == "c":
         from .c_device import firmware_stream
 
         return firmware_stream(session.raw, session.t_us, session.temp, sample_rate=session.sample_rate,
-                               sensitivity=session.sensitivity)
-    hello = Hello(session.sample_rate, session.sensitivity, "deg/s", session.temp is not None, firmware="gyrocal-sim")
-    return encode(hello) + encode_samples(np.arange(len(session)), session.t_us, session.raw, session.temp)
+                               sensitivity=session.sensitivity, accel=session.accel, accel_sensitivity=accel_sens)
+    hello = Hello(session.sample_rate, session.sensitivity, "deg/s", session.temp is not None, firmware="gyrocal-sim",
+                  accel_sensitivity=accel_sens or None)
+    samples = encode_samples(np.arange(len(session)), session.t_us, session.raw, session.temp, session.accel)
+    return encode(hello) + samples + encode(End(len(session)))
+
+
+def preamble(data: bytes) -> bytes:
+    """What a device repeats until a reader listens: its hello frame, or an empty line for text."""
+    frames = FrameDecoder().feed(data[:64])
+    return encode(frames[0]) if frames and isinstance(frames[0], Hello) else b"\r\n"
+
+
+def _ends_session(data: bytes) -> bool:
+    """Whether `data` ends with the end-of-session marker (an end frame, or the text line)."""
+    if data.rstrip().endswith(END_LINE.encode()):
+        return True
+    tail = FrameDecoder().feed(data[-(End.FORMAT.size + 6):])
+    return bool(tail) and isinstance(tail[-1], End)
 
 
 class VirtualDevice:
@@ -154,16 +189,18 @@ class VirtualDevice:
         Pace [bytes/s] (the baud rate over 10 for 8N1); default as fast as the reader takes them.
     wait_for : {"release", "reader"}
         When sending starts: on :meth:`release` (a test calls it once the reader has the port open:
-        pyserial discards what is waiting when it opens a port), or when a reader opens the
-        pseudo-terminal (seen as its settings changing, then ``settle`` seconds for pyserial to
-        finish opening; for people, not for tests).
+        pyserial discards what is waiting when it opens a port), or once a reader has opened the
+        pseudo-terminal (the device repeats :func:`preamble` until the reader takes bytes or empties
+        the queue; for people, not for tests).
+    drain_timeout : float
+        Longest wait for the reader to take everything or to hang up [s].
     """
 
     def __init__(self, data: bytes, *, faults: Faults = Faults(), byte_rate: float | None = None,
                  transport: Literal["pty", "tcp"] = "pty", chunk: int = 256, drain_timeout: float = 60.0,
-                 wait_for: Literal["release", "reader"] = "release", settle: float = 0.5):
+                 wait_for: Literal["release", "reader"] = "release"):
         self.data, self.faults, self.byte_rate, self.transport = data, faults, byte_rate, transport
-        self.wait_for, self.settle = wait_for, settle
+        self.wait_for = wait_for
         self._go = threading.Event()
         self.paused = threading.Event()  # set once the reader has taken everything sent before the stall
         self._resume = threading.Event()
@@ -180,7 +217,7 @@ class VirtualDevice:
         if self.transport == "pty":
             self._master, self._slave = pty.openpty()
             tty.setraw(self._slave)  # no echo, no newline translation: binary passes unchanged
-            port = os.ttyname(self._slave)
+            port = self._path = os.ttyname(self._slave)
             target = self._serve_pty
         else:
             self._server = socket.create_server(("127.0.0.1", 0))
@@ -200,13 +237,23 @@ class VirtualDevice:
 
     def _wait_to_start(self) -> None:
         if self.wait_for == "reader" and self.transport == "pty":
-            mine = termios.tcgetattr(self._slave)
-            while not self._stop.is_set() and termios.tcgetattr(self._slave) == mine:
-                self._stop.wait(0.05)
-            self._stop.wait(self.settle)
-            self._go.set()
+            self._wait_for_reader()
         while not (self._go.is_set() or self._stop.is_set()):
             self._go.wait(0.2)
+
+    def _wait_for_reader(self, cap: int = 2048) -> None:
+        """Repeat the preamble until the reader's queue shrinks: it read bytes, or pyserial emptied it on
+        opening the port. Either way the emptying is over, and nothing sent from now on is lost."""
+        pre, written, most = preamble(self.data), 0, 0
+        while not self._stop.is_set():
+            if written < cap and select.select([], [self._master], [], 0)[1]:
+                written += os.write(self._master, pre)
+            queued = self._unread()
+            if queued < most:
+                self._go.set()
+                return
+            most = max(most, queued)
+            self._stop.wait(0.02)
 
     def wait(self, timeout: float | None = None) -> bool:
         """Wait until the device has sent everything and closed the link."""
@@ -234,7 +281,6 @@ class VirtualDevice:
 
     def _pieces(self):
         """The stream in pieces, paced, with the stall and the cut."""
-        self._wait_to_start()
         cut, stall = self._plan()
         t0 = time.monotonic()
         pos = 0
@@ -259,22 +305,50 @@ class VirtualDevice:
 
     def _serve_pty(self) -> None:
         try:
+            self._wait_to_start()
+            # from now on only the reader holds the port open, so its hang-up shows on the master
+            os.close(self._slave)
+            self._slave = None
             for piece in self._pieces():
                 view = memoryview(piece)
                 while view and not self._stop.is_set():
+                    if self._hung_up():
+                        return  # the reader has gone (its capture ended): nobody to send to
                     if select.select([], [self._master], [], 0.2)[1]:
                         n = os.write(self._master, view)
                         view = view[n:]
                         self.sent += n
-            self._drain()
+            if self.sent == len(self.data) and _ends_session(self.data):
+                self._hang_up_wait()
+            else:
+                self._drain()
         finally:
             os.close(self._master)
-            os.close(self._slave)
+            if self._slave is not None:
+                os.close(self._slave)
             self.done.set()
 
+    def _hung_up(self, timeout_ms: int = 0) -> bool:
+        poll = select.poll()
+        poll.register(self._master, select.POLLHUP)
+        return bool(poll.poll(timeout_ms))
+
+    def _hang_up_wait(self) -> None:
+        """Wait until the reader, having read the end-of-session marker, closes the port."""
+        deadline = time.monotonic() + self.drain_timeout
+        while not self._stop.is_set() and time.monotonic() < deadline:
+            if self._hung_up(200):
+                return
+
     def _unread(self) -> int:
-        buf = fcntl.ioctl(self._slave, termios.FIONREAD, struct.pack("i", 0))
-        return struct.unpack("i", buf)[0]
+        """Bytes sent that the reader has not read yet (its input queue; the port is opened for a moment when
+        the device no longer holds it, which does not disturb the reader)."""
+        fd = self._slave if self._slave is not None else os.open(self._path, os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK)
+        try:
+            return struct.unpack("i", fcntl.ioctl(fd, termios.FIONREAD, struct.pack("i", 0)))[0]
+        finally:
+            if fd != self._slave:
+                os.close(fd)
 
     def _drain(self, quiet: float = 0.5) -> None:
         """Wait until the reader has taken every byte sent: closing a pty discards unread input.
@@ -286,6 +360,8 @@ class VirtualDevice:
         empty_since = None
         while time.monotonic() < deadline and not self._stop.is_set():
             now = time.monotonic()
+            if self._hung_up():
+                return
             if self._unread():
                 empty_since = None
             elif empty_since is None:
@@ -299,6 +375,7 @@ class VirtualDevice:
             self._server.settimeout(self.drain_timeout)
             conn, _ = self._server.accept()
             with conn:
+                self._wait_to_start()
                 for piece in self._pieces():
                     conn.sendall(piece)
                     self.sent += len(piece)

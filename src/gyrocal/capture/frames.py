@@ -26,9 +26,11 @@ __all__ = [
     "TURN_LABELS",
     "Calibrated",
     "DecoderStats",
+    "End",
     "Frame",
     "FrameDecoder",
     "Hello",
+    "ImuSample",
     "Result",
     "Sample",
     "Text",
@@ -64,7 +66,8 @@ def _frame(kind: int, payload: bytes) -> bytes:
 
 @dataclass(frozen=True)
 class Hello:
-    """What the device is: sample rate [Hz], sensitivity [counts per `rate_unit`], firmware."""
+    """What the device is: sample rate [Hz], sensitivity [counts per `rate_unit`], firmware, and the
+    accelerometer's sensitivity [counts per g] when it sends 6-axis samples (None without)."""
 
     TYPE = 0x01
     FORMAT = struct.Struct("<BBBBffHH16s")
@@ -75,16 +78,19 @@ class Hello:
     library: int = 2  # GYROCAL_CAL_VERSION
     firmware: str = ""
     protocol: int = PROTOCOL
+    accel_sensitivity: int | None = None
 
     def payload(self) -> bytes:
-        return self.FORMAT.pack(self.protocol, int(self.has_temp), _UNITS.index(self.rate_unit), 0, self.sample_rate,
-                                self.sensitivity, self.library, 0, self.firmware.encode()[:16])
+        flags = int(self.has_temp) | (2 if self.accel_sensitivity else 0)
+        return self.FORMAT.pack(self.protocol, flags, _UNITS.index(self.rate_unit), 0, self.sample_rate,
+                                self.sensitivity, self.library, self.accel_sensitivity or 0,
+                                self.firmware.encode()[:16])
 
     @classmethod
     def parse(cls, p: bytes) -> Hello:
-        proto, flags, unit, _, fs, sens, lib, _, fw = cls.FORMAT.unpack(p)
+        proto, flags, unit, _, fs, sens, lib, accel, fw = cls.FORMAT.unpack(p)
         return cls(fs, sens, _UNITS[unit] if unit < len(_UNITS) else f"unit {unit}", bool(flags & 1), lib,
-                   fw.split(b"\0")[0].decode("utf-8", "replace"), proto)
+                   fw.split(b"\0")[0].decode("utf-8", "replace"), proto, accel if flags & 2 and accel else None)
 
 
 @dataclass(frozen=True)
@@ -107,6 +113,28 @@ class Sample:
     def parse(cls, p: bytes) -> Sample:
         seq, t_us, gx, gy, gz, temp = cls.FORMAT.unpack(p)
         return cls(seq, t_us, (gx, gy, gz), None if temp == TEMP_NONE else temp / 100.0)
+
+
+@dataclass(frozen=True)
+class ImuSample:
+    """One raw 6-axis sample: as :class:`Sample`, with the accelerometer ``accel`` [counts]."""
+
+    TYPE = 0x07
+    FORMAT = struct.Struct("<IIhhhhhhh")
+    seq: int
+    t_us: int
+    raw: tuple[int, int, int]
+    accel: tuple[int, int, int]
+    temp: float | None = None
+
+    def payload(self) -> bytes:
+        temp = TEMP_NONE if self.temp is None else round(self.temp * 100)
+        return self.FORMAT.pack(self.seq & 0xFFFFFFFF, self.t_us & 0xFFFFFFFF, *self.raw, *self.accel, temp)
+
+    @classmethod
+    def parse(cls, p: bytes) -> ImuSample:
+        seq, t_us, gx, gy, gz, ax, ay, az, temp = cls.FORMAT.unpack(p)
+        return cls(seq, t_us, (gx, gy, gz), (ax, ay, az), None if temp == TEMP_NONE else temp / 100.0)
 
 
 @dataclass(frozen=True)
@@ -206,10 +234,28 @@ class Text:
         return cls(p.decode("utf-8", "replace"))
 
 
-Frame = Hello | Sample | Calibrated | Turn | Result | Text
-_KINDS = {cls.TYPE: cls for cls in (Hello, Sample, Calibrated, Turn, Result, Text)}
+@dataclass(frozen=True)
+class End:
+    """The session is over (a recorded or simulated device; a live board never ends): ``samples``
+    sample frames were sent in all. Whoever reads it has everything the device sent."""
+
+    TYPE = 0x08
+    FORMAT = struct.Struct("<I")
+    samples: int | None  # None: the text line's end, which carries no count
+
+    def payload(self) -> bytes:
+        return self.FORMAT.pack((self.samples or 0) & 0xFFFFFFFF)
+
+    @classmethod
+    def parse(cls, p: bytes) -> End:
+        return cls(cls.FORMAT.unpack(p)[0])
+
+
+Frame = Hello | Sample | ImuSample | Calibrated | Turn | Result | Text | End
+_FIXED = (Hello, Sample, ImuSample, Calibrated, Turn, Result, End)
+_KINDS = {cls.TYPE: cls for cls in (*_FIXED, Text)}
 #: Fixed payload length per type (TEXT: any length up to MAX_PAYLOAD).
-_LENGTHS = {cls.TYPE: cls.FORMAT.size for cls in (Hello, Sample, Calibrated, Turn, Result)}
+_LENGTHS = {cls.TYPE: cls.FORMAT.size for cls in _FIXED}
 
 
 def encode(frame: Frame) -> bytes:
@@ -217,17 +263,21 @@ def encode(frame: Frame) -> bytes:
     return _frame(frame.TYPE, frame.payload())
 
 
-def encode_samples(seq, t_us, raw, temp=None) -> bytes:
+def encode_samples(seq, t_us, raw, temp=None, accel=None) -> bytes:
     """Sample frames for many samples at once: seq (N,), t_us (N,) [us], raw (N, 3) [counts],
-    temp (N,) [degC] or None."""
+    temp (N,) [degC] or None; with accel (N, 3) [counts], 6-axis (IMU) frames."""
     n = len(seq)
-    rec = np.zeros(n, dtype=[("sync", "u1", 2), ("type", "u1"), ("len", "u1"), ("seq", "<u4"), ("t", "<u4"),
-                             ("g", "<i2", 3), ("temp", "<i2"), ("crc", "<u2")])
+    kind = Sample if accel is None else ImuSample
+    fields = [("sync", "u1", 2), ("type", "u1"), ("len", "u1"), ("seq", "<u4"), ("t", "<u4"), ("g", "<i2", 3)]
+    fields += [] if accel is None else [("a", "<i2", 3)]
+    rec = np.zeros(n, dtype=[*fields, ("temp", "<i2"), ("crc", "<u2")])
     rec["sync"] = tuple(SYNC)
-    rec["type"], rec["len"] = Sample.TYPE, Sample.FORMAT.size
+    rec["type"], rec["len"] = kind.TYPE, kind.FORMAT.size
     rec["seq"] = np.asarray(seq, dtype=np.int64) & 0xFFFFFFFF
     rec["t"] = np.asarray(t_us, dtype=np.int64) & 0xFFFFFFFF
     rec["g"] = raw
+    if accel is not None:
+        rec["a"] = accel
     rec["temp"] = TEMP_NONE if temp is None else np.round(np.asarray(temp, dtype=float) * 100)
     view = rec.view(np.uint8).reshape(n, -1)
     rec["crc"] = [crc16(row[2:-2].tobytes()) for row in view]
@@ -305,8 +355,11 @@ class FrameDecoder:
         frame = cls.parse(payload)
         st.frames += 1
         st.by_type[cls.__name__] = st.by_type.get(cls.__name__, 0) + 1
-        if isinstance(frame, Sample):
+        if cls is Sample:
             frame = Sample(frame.seq, self._unwrap(frame.t_us), frame.raw, frame.temp)
+            self._track(frame.seq)
+        elif cls is ImuSample:
+            frame = ImuSample(frame.seq, self._unwrap(frame.t_us), frame.raw, frame.accel, frame.temp)
             self._track(frame.seq)
         return frame
 

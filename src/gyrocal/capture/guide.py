@@ -32,6 +32,9 @@ __all__ = ["GUIDES", "Guide", "GuideEvent", "Step"]
 
 #: Scale factors a guided turn may imply: its measured size within 25 % of the asked one.
 _GUIDE_K_RANGE = (0.8, 1 / 0.75)
+#: A step still open after this much data [s] looks only at the last _KEEP_S of it (memory and time stay
+#: bounded while nobody moves; a turn must take less than that).
+_MAX_STEP_S, _KEEP_S = 120.0, 60.0
 
 
 @dataclass(frozen=True)
@@ -109,6 +112,14 @@ class Guide:
         """The accepted windows (samples of the whole recording), for the final calibration."""
         return tuple(self._accepted)
 
+    @property
+    def keep_from(self) -> int:
+        """First sample (absolute index) the guide may still look at."""
+        return self.since
+
+    def status(self) -> str:
+        return f"step {self.index + 1} of {len(self.steps)}"
+
     def start(self) -> list[GuideEvent]:
         return [self._prompt()]
 
@@ -126,8 +137,9 @@ class Guide:
         self.since = self._checked = n_samples
         return [GuideEvent("redo", self.index, f"redo step {self.index + 1}"), self._prompt()]
 
-    def update(self, rec: Recording, every: float = 0.25) -> list[GuideEvent]:
-        """Judge the current step on the recording so far (rad/s, or counts with a sensitivity).
+    def update(self, rec: Recording, every: float = 0.25, offset: int = 0) -> list[GuideEvent]:
+        """Judge the current step on the recording so far (rad/s, or counts with a sensitivity): `rec` holds
+        samples ``offset ..`` of the capture (absolute indices), from :attr:`keep_from` on or earlier.
 
         Steps are judged at fixed points of the data (every `every` seconds of samples), so the
         outcome does not depend on how the samples arrived in chunks.
@@ -135,17 +147,20 @@ class Guide:
         fs = rec.sample_rate
         stride = max(1, round(every * fs))
         events: list[GuideEvent] = []
-        while not self.complete and self._checked + stride <= len(rec):
+        while not self.complete and self._checked + stride <= offset + len(rec):
             self._checked += stride
-            events += self._judge(rec, self._checked)
+            events += self._judge(rec, offset, self._checked)
         return events
 
-    def _judge(self, rec: Recording, n: int) -> list[GuideEvent]:
+    def _judge(self, rec: Recording, offset: int, n: int) -> list[GuideEvent]:
         fs = rec.sample_rate
+        if n - self.since > _MAX_STEP_S * fs:
+            self.since = n - int(_KEEP_S * fs)
         # segmentation needs about a second of data to find the standstill level
         if n - self.since < max(1.0, self.settle) * fs:
             return []
-        sub = Recording(t=rec.t[self.since:n], gyro=rec.gyro[self.since:n], units=rec.units,
+        part = slice(self.since - offset, n - offset)
+        sub = Recording(t=rec.t[part], gyro=rec.gyro[part], units=rec.units,
                         source_units=rec.source_units, sample_rate=fs, sensitivity=rec.sensitivity)
         step = self.steps[self.index]
         ref = {"reference": "speed", "speed": self.speed} if self.speed else {"reference": "angle", "angle": self.angle}

@@ -2,9 +2,11 @@
 
 The port is anything pyserial opens (``serial.serial_for_url``): a USB serial device, a
 pseudo-terminal, ``socket://host:port``. A capture ends on a duration of data, a number of
-samples, the end of the stream (the link closed or the cable came out), a long silence, or a
-stop request (Ctrl-C, SIGTERM: the caller's `stop` callable). Whichever way it ends, everything
-decoded is written and the file is put in place (:class:`~gyrocal.capture.store.SampleStore`).
+samples, the device's end of session (an end frame, or the text line ``# end of session``),
+the end of the stream (the link closed or the cable came out), a long silence, or a stop
+request (Ctrl-C, SIGTERM: the caller's `stop` callable). Whichever way it ends, everything
+decoded is written and the file is put in place (:class:`~gyrocal.capture.store.SampleStore`);
+memory holds only recent samples, so a capture may run for hours.
 """
 
 from __future__ import annotations
@@ -15,14 +17,15 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 from ..errors import GyrocalError, InputError, MissingDependencyError
-from .frames import Calibrated, FrameDecoder, Hello, Result, Sample, Text, Turn
+from .device_log import DeviceLog
+from .frames import Calibrated, End, FrameDecoder, Hello, ImuSample, Result, Sample, Text, Turn
 from .store import SampleStore
 from .text import TextDecoder
 
 __all__ = ["Capture", "CaptureResult", "LinkError", "open_port"]
 
 Wire = Literal["auto", "frames", "text"]
-Ending = Literal["duration", "samples", "end of stream", "stopped", "silence", "guide complete"]
+Ending = Literal["duration", "samples", "end of session", "end of stream", "stopped", "silence", "guide complete"]
 
 
 class LinkError(GyrocalError):
@@ -52,16 +55,23 @@ class CaptureResult:
     ended: str
     wire: str | None
     hello: Hello | None
-    turns: list[Turn] = field(default_factory=list)
-    results: list[Result] = field(default_factory=list)
-    calibrated: list[Calibrated] = field(default_factory=list)
-    messages: list[str] = field(default_factory=list)
+    device: DeviceLog
+    messages: list[str] = field(default_factory=list)  # the last 100
     stalls: list[float] = field(default_factory=list)
     stats: Any = None
+    sent: int | None = None  # samples the device says it sent (its end frame)
 
     @property
     def samples(self) -> int:
         return len(self.store)
+
+    @property
+    def turns(self) -> list[Turn]:
+        return self.device.turns
+
+    @property
+    def results(self) -> list[Result]:
+        return self.device.results
 
 
 class Capture:
@@ -105,7 +115,8 @@ class Capture:
         self.on_event = on_event or (lambda kind, payload: None)
         self._frames = FrameDecoder() if wire in ("auto", "frames") else None
         self._text = TextDecoder(columns) if wire in ("auto", "text") else None
-        self.result = CaptureResult(out, SampleStore(out, header_comment or self._comment), "", None, None)
+        store = SampleStore(out, header_comment or self._comment)
+        self.result = CaptureResult(out, store, "", None, None, DeviceLog(store))
         self._t_wall0: float | None = None
 
     def link_stats(self):
@@ -139,17 +150,19 @@ class Capture:
         """Record decoded items; True when a sample limit or the duration is reached."""
         r, store = self.result, self.result.store
         for item in items:
-            if isinstance(item, Sample):
-                t, g, temp, seq = item.t_us * 1e-6, item.raw, item.temp, item.seq
+            if isinstance(item, (Sample, ImuSample)):
+                t, g, temp, seq, a = item.t_us * 1e-6, item.raw, item.temp, item.seq, getattr(item, "accel", None)
             elif hasattr(item, "g"):  # a text Reading
-                t, g, temp, seq = item.t, item.g, item.temp, None
+                t, g, temp, seq, a = item.t, item.g, item.temp, None, item.a
             else:
                 self._device_frame(item)
+                if r.ended:
+                    return True
                 continue
             if self.duration is not None and self._beyond(t):
                 r.ended = "duration"
                 return True
-            store.add(t, g, temp, seq)
+            store.add(t, g, temp, seq, a)
             if self.max_samples is not None and len(store) >= self.max_samples:
                 r.ended = "samples"
                 return True
@@ -165,25 +178,32 @@ class Capture:
     def _device_frame(self, f) -> None:
         r = self.result
         if isinstance(f, Hello):
-            r.hello = f
-            self.on_event("hello", f)
+            if f != r.hello:  # a device may repeat its hello until someone listens
+                r.hello = f
+                self.on_event("hello", f)
         elif isinstance(f, Turn):
-            r.turns.append(f)
+            r.device.turn(f)
             self.on_event("turn", f)
         elif isinstance(f, Result):
-            r.results.append(f)
+            r.device.result(f)
             self.on_event("result", f)
         elif isinstance(f, Calibrated):
-            r.calibrated.append(f)
+            r.device.calibrated(f)
         elif isinstance(f, Text):
             r.messages.append(f.text)
+            del r.messages[:-100]
             self.on_event("message", f.text)
+        elif isinstance(f, End):
+            r.sent = f.samples
+            r.ended = "end of session"
 
     # -- the loop --------------------------------------------------------------------------------------------
 
     def run(self, stop: Callable[[], bool] = lambda: False,
-            each: Callable[[Capture], bool] | None = None) -> CaptureResult:
-        """Read until an end condition; `each` runs after every read and may end the capture (True).
+            each: Callable[[Capture], bool] | None = None,
+            keep_from: Callable[[], int | None] | None = None) -> CaptureResult:
+        """Read until an end condition; `each` runs after every read and may end the capture (True);
+        `keep_from` says from which sample (absolute index) on `each` still needs the samples in memory.
 
         Whatever ends it, the file holds every sample decoded and is put in place before returning.
         """
@@ -224,6 +244,8 @@ class Capture:
                 if now - last_show >= 0.5:
                     last_show = now
                     r.store.flush()
+                    r.device.settle()
+                    r.store.trim(None if keep_from is None else keep_from())
                     self.on_event("progress", self)
         finally:
             ser.close()
@@ -231,6 +253,7 @@ class Capture:
                 self._text.finish()
             r.ended = r.ended or "stopped"
             r.stats = self.link_stats()
+            r.device.settle()
             r.path = r.store.finish()
         if stalled:
             r.stalls.append(time.monotonic() - last_data)

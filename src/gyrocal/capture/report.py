@@ -9,11 +9,12 @@ import numpy as np
 
 from ..io import read_recording
 from ..pipeline import CalibrationRun, calibrate
-from .agreement import Agreement, check_device
-from .frames import Result, Turn
+from .agreement import Agreement
+from .frames import Turn
 from .recorder import Capture, CaptureResult
 
-__all__ = ["calibrate_capture", "device_check", "device_turn_line", "host_versus_device", "progress_line", "summary"]
+__all__ = ["calibrate_capture", "calibrate_imu_capture", "device_check", "device_turn_line", "host_versus_device",
+           "progress_line", "summary"]
 
 
 def _rate(store) -> float | None:
@@ -62,6 +63,13 @@ def summary(result: CaptureResult) -> list[str]:
     lost = {k: v for k, v in losses(result.stats).items() if v}
     if store.out_of_order:
         lost["samples out of time order (left out)"] = store.out_of_order
+    if store.missing_accel:
+        lost["samples without the accelerometer (left out)"] = store.missing_accel
+    if result.sent is not None:  # the device's end frame says how many it sent: losses before the first or
+        gaps = getattr(result.stats, "lost_samples", 0)  # after the last sample received show only here
+        unseen = result.sent - (n + store.out_of_order + store.missing_accel + gaps)
+        if unseen > 0:
+            lost[f"of the {result.sent:,} samples the device sent, missing at the start or end"] = unseen
     lines.append("link: " + (", ".join(f"{v:,} {k}" for k, v in lost.items()) if lost else "nothing lost")
                  + (f"; {len(result.stalls)} stall(s), longest {max(result.stalls):.1f} s" if result.stalls else ""))
     return lines
@@ -74,33 +82,7 @@ def device_turn_line(t: Turn) -> str:
 
 def device_check(result: CaptureResult) -> Agreement | None:
     """Recompute the device's last successful result on the host (None when it sent none)."""
-    ok = [r for r in result.results if r.status == 0]
-    if not ok:
-        return None
-    last: Result = ok[-1]
-    turns: dict[int, Turn] = {}
-    for t in result.turns:  # the turns filed before that result; a later one of a slot replaces an earlier
-        if t.status == 0 and t.stop <= last.seq + 1:
-            turns[t.slot] = t
-    if len(turns) < 6:
-        return None
-    samples = {s: result.store.samples_by_seq(t.start, t.stop) for s, t in turns.items()}
-    return check_device(turns, last, {s: x for s, x in samples.items() if x is not None}, _corrected(result, last))
-
-
-def _corrected(result: CaptureResult, last: Result):
-    """Raw and corrected samples with the same sequence number, corrected by `last` (before a later result)."""
-    later = [r.seq for r in result.results if r.seq > last.seq]
-    end = min(later) if later else None
-    cal = [c for c in result.calibrated if c.seq >= last.seq and (end is None or c.seq < end)]
-    if not cal:
-        return None
-    seq = result.store.seq
-    idx = np.searchsorted(seq, [c.seq for c in cal])
-    ok = (idx < len(seq)) & (seq[np.minimum(idx, len(seq) - 1)] == [c.seq for c in cal])
-    raw = result.store.gyro[idx[ok]]
-    w = np.array([c.w for c, keep in zip(cal, ok) if keep]).reshape(-1, 3)
-    return raw, w
+    return result.device.check()
 
 
 def calibrate_capture(path: Path, *, units: str, sensitivity: float | None, sample_rate: float | None = None,
@@ -109,6 +91,17 @@ def calibrate_capture(path: Path, *, units: str, sensitivity: float | None, samp
     rec = read_recording(path, units=units, sensitivity=sensitivity, sample_rate=sample_rate)
     ref = {"speed": speed} if speed is not None else {"angle": 2 * math.pi}
     return calibrate(rec, windows=windows, output_units="deg/s" if units == "counts" else None, **ref)
+
+
+def calibrate_imu_capture(path: Path, *, units: str, sensitivity: float | None, accel_units: str,
+                          accel_sensitivity: float | None, sample_rate: float | None = None, windows=None):
+    """Calibrate gyro and accelerometer from the written recording, as ``gyrocal imu`` would read it (the guide's
+    poses, if any); an :class:`~gyrocal.imu.run.ImuRun`."""
+    from ..imu.run import calibrate_recording
+
+    rec = read_recording(path, units=units, sensitivity=sensitivity, sample_rate=sample_rate, accel_units=accel_units,
+                         accel_sensitivity=accel_sensitivity, need_accel=True)
+    return calibrate_recording(rec, windows=windows)
 
 
 def host_versus_device(run: CalibrationRun, agreement: Agreement, sensitivity: float) -> list[str]:

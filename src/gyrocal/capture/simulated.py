@@ -1,6 +1,7 @@
-"""Simulated device sessions: what a gyro on a microcontroller reads during a servo or hand session.
+"""Simulated device sessions: what a gyro (and an accelerometer) on a microcontroller reads during a
+servo or hand session, or a multi-position hand session of the whole IMU.
 
-The motion and the sensor come from :mod:`gyrocal.simulation`; this module turns the readings
+The motion and the sensors come from :mod:`gyrocal.simulation`; this module turns the readings
 into what a device sends: raw counts (int16) at a sensitivity, microsecond time stamps of the
 device's clock and the temperature in hundredths of a degree.
 """
@@ -15,13 +16,16 @@ import numpy as np
 
 from .._validation import positive
 from ..models import ScaleBias
+from ..recording import Recording
 from ..simulation import ServoProtocol, VirtualGyro, simulate_servo
 from ..windows import Window
 
-__all__ = ["MPU6050_SENSITIVITY", "DeviceSession", "simulate_device_session"]
+__all__ = ["MPU6050_ACCEL_SENSITIVITY", "MPU6050_SENSITIVITY", "DeviceSession", "counts", "simulate_device_session"]
 
 #: LSB per deg/s of an MPU-6050 / MPU-9250 at +-250 deg/s.
 MPU6050_SENSITIVITY = 131.0
+#: LSB per g of its accelerometer at +-2 g.
+MPU6050_ACCEL_SENSITIVITY = 16384
 
 
 @dataclass(frozen=True)
@@ -40,10 +44,18 @@ class DeviceSession:
         Nominal rate [Hz].
     sensitivity : float
         [counts per deg/s].
-    model : ScaleBias
-        The true gyro, servo method of Wang et al. eq. 1, internal units (rad/s).
+    model : ScaleBias or Affine
+        The true gyro, internal units (rad/s): servo method of Wang et al. eq. 1, or a gyro
+        mounted at an angle to the accelerometer (multi-position sessions).
     windows : tuple of Window
         Every true turn and static stretch, in samples of this session.
+    accel : ndarray of int16, shape (N, 3), or None
+        Accelerometer readings [counts] (multi-position sessions).
+    accel_sensitivity : int or None
+        [counts per g].
+    truth : dict or None
+        Multi-position sessions: the simulator's truth (:attr:`gyrocal.simulation.multiposition.ImuSession.truth`,
+        internal units: rad/s and m/s^2).
     """
 
     raw: np.ndarray
@@ -53,6 +65,9 @@ class DeviceSession:
     sensitivity: float
     model: ScaleBias
     windows: tuple[Window, ...]
+    accel: np.ndarray | None = None
+    accel_sensitivity: int | None = None
+    truth: dict | None = None
 
     def __len__(self) -> int:
         return len(self.raw)
@@ -70,6 +85,17 @@ class DeviceSession:
     @property
     def turns(self) -> tuple[Window, ...]:
         return tuple(w for w in self.windows if w.kind == "rotation")
+
+    def recording(self, start: int = 0, stop: int | None = None, gravity: float = 9.80665) -> Recording:
+        """Samples ``start:stop`` as ``gyrocal capture`` reads them: counts at the session's sensitivities, in
+        rad/s and m/s^2, the time from the first sample of the session [s]."""
+        part = slice(start, len(self) if stop is None else stop)
+        kw = {}
+        if self.accel is not None:
+            kw = dict(accel=self.accel[part] * (gravity / self.accel_sensitivity), accel_units="m/s^2",
+                      accel_source_units="counts", accel_sensitivity=self.accel_sensitivity)
+        return Recording(t=(self.t_us[part] - self.t_us[0]) * 1e-6, gyro=np.radians(self.raw[part] / self.sensitivity),
+                         source_units="counts", sensitivity=self.sensitivity, **kw)
 
 
 def simulate_device_session(
@@ -116,9 +142,17 @@ def simulate_device_session(
         windows += [Window(w.start + offset, w.stop + offset, w.kind, w.axis, w.sign, w.angle, w.rate, w.label)
                     for w in truth.windows]
         offset += len(rec)
-    counts = np.concatenate(chunks) * (180.0 / math.pi) * sens
-    raw = np.clip(np.round(counts), -32768, 32767).astype(np.int16)
+    raw = counts(np.concatenate(chunks) * (180.0 / math.pi) * sens)
     n = len(raw)
     t_us = np.round(np.arange(n) * (1e6 / fs) * (1 + 1e-6 * clock_ppm)).astype(np.int64) + 1_000_000
-    t = None if temp is None else np.round((temp + 0.5 * np.arange(n) / max(n, 1)) * 100) / 100
-    return DeviceSession(raw, t_us, t, fs, sens, model, tuple(windows))
+    return DeviceSession(raw, t_us, _temperature(temp, n), fs, sens, model, tuple(windows))
+
+
+def counts(x) -> np.ndarray:
+    """Readings rounded to whole counts and clipped to int16, as a sensor's register holds them."""
+    return np.clip(np.round(x), -32768, 32767).astype(np.int16)
+
+
+def _temperature(temp: float | None, n: int) -> np.ndarray | None:
+    """[degC] in steps of 0.01, drifting by 0.5 degC over the session; None for a device without one."""
+    return None if temp is None else np.round((temp + 0.5 * np.arange(n) / max(n, 1)) * 100) / 100

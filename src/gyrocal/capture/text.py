@@ -1,10 +1,11 @@
-"""Text lines as an Arduino ``Serial.println`` sends them: ``t,gx,gy,gz[,temp]``.
+"""Text lines as an Arduino ``Serial.println`` sends them: ``t,gx,gy,gz[,temp][,ax,ay,az]``.
 
 The first line whose fields are names is the header; columns are found by gyrocal's names
-and aliases (as in a CSV file), and a time column named ``t_ms``/``millis`` or ``t_us``/
-``micros`` is scaled to seconds. Without a header, ``columns`` gives column numbers,
-counting from 1 (``{"t": 1, "gx": 2, "gy": 3, "gz": 4}``). A line that is not a sample is
-skipped and counted, never fatal; lines starting with ``#`` are messages from the device.
+and aliases (as in a CSV file, the accelerometer's ``ax, ay, az`` included), and a time column
+named ``t_ms``/``millis`` or ``t_us``/``micros`` is scaled to seconds. Without a header,
+``columns`` gives column numbers, counting from 1 (``{"t": 1, "gx": 2, "gy": 3, "gz": 4}``).
+A line that is not a sample is skipped and counted, never fatal; lines starting with ``#`` are
+messages from the device, and the line ``# end of session`` says the device sends nothing more.
 """
 
 from __future__ import annotations
@@ -14,8 +15,13 @@ from dataclasses import dataclass, field
 
 from ..errors import InputError
 from ..io.columns import resolve, time_scale
+from .frames import End
 
-__all__ = ["Reading", "TextDecoder", "TextStats"]
+__all__ = ["END_LINE", "Reading", "TextDecoder", "TextStats"]
+
+#: The line a device sends when the session is over (a recorded or simulated one).
+END_LINE = "# end of session"
+_ACCEL = ("ax", "ay", "az")
 
 _MAX_LINE = 512  # a longer line is noise (a baud mismatch reads as long garbage)
 _SEPARATORS = (",", ";", "\t", " ")
@@ -23,11 +29,13 @@ _SEPARATORS = (",", ";", "\t", " ")
 
 @dataclass(frozen=True)
 class Reading:
-    """One sample from a text line: ``t`` [s] or None, ``g`` [the data's unit], ``temp`` [degC] or None."""
+    """One sample from a text line: ``t`` [s] or None, ``g`` [the data's unit], ``temp`` [degC] or None,
+    ``a`` the accelerometer [its unit] or None."""
 
     t: float | None
     g: tuple[float, float, float]
     temp: float | None = None
+    a: tuple[float, float, float] | None = None
 
 
 @dataclass
@@ -57,7 +65,8 @@ def _numbers(fields: list[str]) -> list[float] | None:
 
 
 class TextDecoder:
-    """Streaming decoder of text lines: ``feed(bytes) -> list of Reading``.
+    """Streaming decoder of text lines: ``feed(bytes) -> list of Reading`` (and an :class:`End` for the
+    end-of-session line).
 
     Parameters
     ----------
@@ -71,6 +80,7 @@ class TextDecoder:
         self._numbers: dict[str, int] | None = None
         self._names = None
         self._t_scale = 1.0
+        self.ended = False
         self.stats = TextStats()
         if columns:
             if all(str(v).strip().isdigit() for v in columns.values()):
@@ -94,11 +104,19 @@ class TextDecoder:
     def has_temp(self) -> bool:
         return self._numbers is not None and "temp" in self._numbers
 
+    @property
+    def has_accel(self) -> bool:
+        return self._numbers is not None and "ax" in self._numbers
+
     def _use(self, cols: dict[str, int], t_scale: float) -> None:
         missing = [c for c in ("gx", "gy", "gz") if c not in cols]
         if missing:
             raise InputError(f"{{param}} gives no column for {', '.join(missing)}", param="columns",
                              hint="map them, e.g. {param} t=1,gx=2,gy=3,gz=4")
+        some = [c for c in _ACCEL if c in cols]
+        if some and len(some) < 3:
+            raise InputError(f"{{param}} gives a column for {', '.join(some)} but not for every accelerometer axis",
+                             param="columns", hint="map all three, e.g. {param} ...,ax=5,ay=6,az=7")
         self._numbers, self._t_scale = cols, t_scale
         self._width = max(cols.values()) + 1
 
@@ -108,15 +126,19 @@ class TextDecoder:
         del msgs[:-20]
 
     def _header(self, fields: list[str]) -> bool:
-        try:
-            mapping = resolve(fields, self._names, "the serial header line")
-        except InputError:
+        for accel in (True, False):  # with the accelerometer's three columns, else without them
+            try:
+                mapping = resolve(fields, self._names, "the serial header line", accel=accel)
+                break
+            except InputError:
+                continue
+        else:
             return False
-        cols = {k: fields.index(v) for k, v in mapping.items() if k in ("t", "gx", "gy", "gz", "temp")}
+        cols = {k: fields.index(v) for k, v in mapping.items() if k in ("t", "gx", "gy", "gz", "temp", *_ACCEL)}
         self._use(cols, time_scale(mapping["t"]) if "t" in mapping else 1.0)
         return True
 
-    def _line(self, raw: bytes, out: list[Reading]) -> None:
+    def _line(self, raw: bytes, out: list) -> None:
         st = self.stats
         st.lines += 1
         try:
@@ -127,6 +149,10 @@ class TextDecoder:
         if not line:
             return
         if line.startswith("#"):
+            if line.lower().startswith(END_LINE):
+                self.ended = True
+                out.append(End(None))  # a text line carries no count
+                return
             self._message(line.lstrip("# "))
             return
         fields = _split(line)
@@ -147,15 +173,18 @@ class TextDecoder:
         c = self._numbers
         t = values[c["t"]] * self._t_scale if "t" in c else None
         temp = values[c["temp"]] if "temp" in c else None
-        out.append(Reading(t, (values[c["gx"]], values[c["gy"]], values[c["gz"]]), temp))
+        a = (values[c["ax"]], values[c["ay"]], values[c["az"]]) if "ax" in c else None
+        out.append(Reading(t, (values[c["gx"]], values[c["gy"]], values[c["gz"]]), temp, a))
         st.samples += 1
 
-    def feed(self, data: bytes) -> list[Reading]:
+    def feed(self, data: bytes) -> list:
         self.stats.bytes += len(data)
         self._buf += data
-        out: list[Reading] = []
+        out: list = []
         *lines, rest = self._buf.split(b"\n")
         for raw in lines:
+            if self.ended:  # nothing after the end counts
+                break
             if len(raw) > _MAX_LINE:
                 self.stats.lines += 1
                 self.stats.bad_lines += 1

@@ -97,6 +97,7 @@ FLAGS: dict[str, str] = {
     "samples": "--samples",
     "silence": "--silence",
     "guide": "--guide",
+    "hold": "--hold",
     "faults": "--faults",
     "pace": "--pace",
     # simulate --reference (a reference gyro's log) and verify, whose reading flags for the reference

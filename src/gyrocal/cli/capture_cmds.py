@@ -8,12 +8,13 @@ import signal
 import sys
 import threading
 import time
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
-from ..choices import CaptureWire, GuideName, InputUnit
+from ..choices import AccelUnit, CaptureWire, GuideName, InputUnit
 from ..errors import GyrocalError, InputError
 from ._outputs import check_output
 from .app import app, console, warn
@@ -80,41 +81,63 @@ def _keys(commands: queue.Queue) -> None:
 class _Guided:
     """Runs the guide on the samples as they arrive and prints what it says."""
 
-    def __init__(self, name: str, speed_rad, units: str, sensitivity, sample_rate, progress: _Progress, stop: _Stop):
-        from ..capture.guide import Guide
+    def __init__(self, name: str, speed_rad, reading, progress: _Progress, stop: _Stop, *, poses: int, hold: float):
+        if name == "multi-position":
+            from ..capture.pose_guide import PoseGuide
 
-        self.guide = Guide(name, speed=speed_rad)
-        self.units, self.sensitivity, self.sample_rate = units, sensitivity, sample_rate
+            self.guide = PoseGuide(poses=poses, hold=hold)
+        else:
+            from ..capture.guide import Guide
+
+            self.guide = Guide(name, speed=speed_rad)
+        self.units, self.sensitivity, self.sample_rate = reading.units, reading.sensitivity, reading.sample_rate
+        self.accel_sensitivity = reading.accel_sensitivity
         self.progress, self.stop = progress, stop
         self.commands: queue.Queue = queue.Queue()
         self.started = False
+        self._judged = -1.0  # data time [s] (or samples, without stamps) of the last look
         threading.Thread(target=_keys, args=(self.commands,), daemon=True).start()
+
+    def keep_from(self) -> int:
+        return self.guide.keep_from
+
+    def _due(self, store) -> bool:
+        """Whether a quarter second of data came since the last look (the guide judges at fixed points of
+        the data, so looking less often changes nothing but the cost)."""
+        now = float(store.t[-1]) if store.has_time else len(store) / (self.sample_rate or 1.0)
+        if now - self._judged < 0.25:
+            return False
+        self._judged = now
+        return True
 
     def _events(self, events) -> None:
         for e in events:
             mark = {"accepted": "ok: ", "refused": "NO: ", "redo": "redo: "}.get(e.kind, "")
             _say(self.progress, f"guide: {mark}{e.text}")
 
-    def __call__(self, cap) -> bool:
+    def __call__(self, cap, force: bool = False) -> bool:
         if not self.started:
             self.started = True
             _say(self.progress, "guide: type r + Enter to redo the last step, q + Enter to stop")
             self._events(self.guide.start())
-        store = cap.result.store
-        sens = self.sensitivity or (cap.result.hello.sensitivity if cap.result.hello else None)
+        store, hello = cap.result.store, cap.result.hello
+        sens = self.sensitivity or (hello.sensitivity if hello else None)
         while not self.commands.empty():
             key = self.commands.get()
             if key == "r":
                 self._events(self.guide.redo(len(store)))
             elif key == "q":
                 self.stop.requested = True
-        if len(store) < 2:
+        if len(store) < 2 or not (self._due(store) or force):
             return False
-        if self.units == "counts" and sens is None:
+        if self.guide.name != "multi-position" and self.units == "counts" and sens is None:
             raise InputError("the guide needs the sensitivity to check the turns' angles (the device's hello frame "
                              "carries it)", param="sensitivity", hint="for text lines in counts give {param} LSB")
         self.sensitivity = sens
-        self._events(self.guide.update(store.recording(self.units, sens, self.sample_rate)))
+        accel = self.accel_sensitivity or (hello.accel_sensitivity if hello else None)
+        start = max(self.guide.keep_from, store.first)
+        rec = store.recording(self.units, sens, self.sample_rate, start=start, accel_sensitivity=accel)
+        self._events(self.guide.update(rec, offset=start))
         return self.guide.complete
 
 
@@ -169,9 +192,19 @@ def capture(
     silence: Annotated[float | None, typer.Option("--silence", help="Stop after S seconds without a "
                                                      "byte (default: no limit).")] = None,
     guide: Annotated[GuideName | None, typer.Option("--guide", help="Guided session: servo (the six turns of the "
-                                                 "servo method of Wang et al.) or hand (default: none, plain recording).")] = None,
+                                                 "servo method of Wang et al.), hand, or multi-position (the whole "
+                                                 "IMU from still poses; needs the accelerometer) (default: none, "
+                                                 "plain recording).")] = None,
     speed: Annotated[float | None, typer.Option("--speed", help="Known turn speed [deg/s] (servo); default "
                                                    "whole 360 deg turns at any speed.")] = None,
+    poses: Annotated[int, typer.Option("--poses", help="multi-position: poses needed (more if they do not yet "
+                                                       "cover the sphere).")] = 12,
+    hold: Annotated[float, typer.Option("--hold", help="multi-position: still time asked for in each pose [s].")]
+    = 2.0,
+    accel_units: Annotated[AccelUnit, typer.Option("--accel-units", help="Unit of text lines' ax, ay, az (frames "
+                                                   "send counts).")] = "counts",
+    accel_sensitivity: Annotated[float | None, typer.Option("--accel-sensitivity", help="Accelerometer counts per g "
+                                                            "(frames: the device says) (default: none).")] = None,
     calibration: Annotated[Path | None, typer.Option("--cal", help="Calibration file to write when the "
                                                         "guide completes (default: beside -o, .cal.json).")] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace existing output files.")] = False,
@@ -189,27 +222,51 @@ def capture(
     if guide:
         check_output(cal_path, flag="--cal", inputs=(output,), force=force, holds="another file")
     progress = _Progress(quiet)
+    speed_rad = None if speed is None else math.radians(speed)
+    reading = _ReadAs(units, sensitivity, sample_rate, accel_units, accel_sensitivity)
     with _Stop() as stop:
-        speed_rad = None if speed is None else math.radians(speed)
-        guided = None if guide is None else _Guided(guide, speed_rad, units, sensitivity, sample_rate, progress, stop)
+        guided = None if guide is None else _Guided(guide, speed_rad, reading, progress, stop, poses=poses, hold=hold)
         cap = Capture(port, output, baud=baud, wire=wire, columns=columns, duration=duration, samples=samples,
                       silence=silence, on_event=_on_event(progress, units))
-        result = cap.run(stop=stop, each=guided)
+        result = cap.run(stop=stop, each=guided, keep_from=None if guided is None else guided.keep_from)
+        if guided is not None and not guided.guide.complete:
+            guided(cap, force=True)  # the last samples, read after the last look
     progress.clear()
-    _finish(result, port, units, sensitivity, sample_rate, guided, cal_path, speed_rad)
+    _finish(result, port, reading, guided, cal_path, speed_rad)
 
 
-def _finish(result, port, units, sensitivity, sample_rate, guided, cal_path, speed_rad) -> None:
-    from ..capture.report import calibrate_capture, device_check, host_versus_device, summary
+@dataclass(frozen=True)
+class _ReadAs:
+    """How the samples received are to be read: the flags, before the device's hello fills in its part."""
+
+    units: str
+    sensitivity: float | None
+    sample_rate: float | None
+    accel_units: str
+    accel_sensitivity: float | None
+
+    def completed(self, hello) -> _ReadAs:
+        """With the sensitivities the device's hello frame gives, where no flag gave them."""
+        if hello is None:
+            return self
+        return replace(self, sensitivity=self.sensitivity or hello.sensitivity,
+                       accel_sensitivity=self.accel_sensitivity or hello.accel_sensitivity)
+
+
+def _finish(result, port, reading: _ReadAs, guided, cal_path, speed_rad) -> None:
+    from ..capture.report import calibrate_capture, summary
 
     if result.path is None:
         raise InputError(f"no samples received from {port}: check the baud rate (--baud), the wire format (--wire) "
                          "and, for text lines, the header or --columns")
     for line in summary(result):
         console.print(line, highlight=False, soft_wrap=True, markup=False)
-    sens = sensitivity or (result.hello.sensitivity if result.hello else None)
+    reading = reading.completed(result.hello)
+    units, sens, sample_rate = reading.units, reading.sensitivity, reading.sample_rate
     calibrate_args = {"units": units, "sensitivity": sens, "sample_rate": sample_rate}
-    if guided is not None and guided.guide.complete:
+    if guided is not None and guided.guide.complete and guided.guide.name == "multi-position":
+        _calibrate_imu(result.path, reading, guided.guide.windows(), cal_path)
+    elif guided is not None and guided.guide.complete:
         run = calibrate_capture(result.path, windows=guided.guide.windows(), speed=speed_rad, **calibrate_args)
         from ..files import save
 
@@ -217,13 +274,36 @@ def _finish(result, port, units, sensitivity, sample_rate, guided, cal_path, spe
         console.print(run.report(), highlight=False, soft_wrap=True, markup=False)
         console.print(f"wrote {cal_path}", highlight=False, markup=False)
     elif guided is not None:
-        warn(f"the guided session stopped at step {guided.guide.index + 1} of {len(guided.guide.steps)}; "
-             "no calibration written (the recording is complete)")
+        warn(f"the guided session stopped at {guided.guide.status()}; no calibration written (the recording is "
+             "complete)")
     else:
         how = f"--units {units}" + (f" --sensitivity {sens:g}" if units == "counts" and sens else "")
         how += "" if result.store.has_time else f" --sample-rate {sample_rate:g}" if sample_rate else " --sample-rate HZ"
         console.print(f"next: gyrocal calibrate {result.path} {how} --angle 360 -o cal.json", highlight=False,
                       soft_wrap=True, markup=False)
+    _device_answer(result, calibrate_args, speed_rad)
+
+
+def _calibrate_imu(path, reading: _ReadAs, windows, cal_path) -> None:
+    """The whole-IMU calibration of a guided multi-position session, from the written recording."""
+    from ..capture.report import calibrate_imu_capture
+    from ..files import save
+    from ._imu_report import print_imu_run
+
+    run = calibrate_imu_capture(path, units=reading.units, sensitivity=reading.sensitivity,
+                                sample_rate=reading.sample_rate, accel_units=reading.accel_units,
+                                accel_sensitivity=reading.accel_sensitivity, windows=windows)
+    save(run.calibration, cal_path)
+    print_imu_run(run, windows_from="the guide")
+    for line in run.warnings:
+        warn(line)
+    console.print(f"wrote {cal_path}", highlight=False, markup=False)
+
+
+def _device_answer(result, calibrate_args: dict, speed_rad) -> None:
+    """The device's own calibration, recomputed on the host and set beside the host's calibration."""
+    from ..capture.report import calibrate_capture, device_check, host_versus_device
+
     agreement = device_check(result)
     if agreement is None:
         return
@@ -231,7 +311,8 @@ def _finish(result, port, units, sensitivity, sample_rate, guided, cal_path, spe
     if not agreement.agrees:
         warn("the device's calibration differs from the host's recomputation beyond float32 rounding: "
              "the firmware does not compute what the gyrocal C library computes on these samples")
-    if sens is not None and units == "counts":
+    sens = calibrate_args["sensitivity"]
+    if sens is not None and calibrate_args["units"] == "counts":
         try:
             run = calibrate_capture(result.path, speed=speed_rad, **calibrate_args)
         except GyrocalError as exc:  # the host's own segmentation found too little: say so, the recording stands

@@ -16,6 +16,7 @@ from ..choices import DeviceWire, Protocol, TimeStamps
 from ..errors import InputError
 from ._options import NoiseDensity, given, noise_std, numbers, refuse_unused, triple
 from ._outputs import check_output, json_format, starts_with
+from ._sim_device import refuse_device_flags, serve_device
 from ._sim_output import announce, output_unit, rate_flags, write_output
 from ._sim_runs import multi_position, profile_run, turntable, turntable_protocol
 from .app import app, console
@@ -181,12 +182,11 @@ def simulate(
     speed, noise, bias_instability, rate_random_walk, quantum, full_scale, b = rate_flags(
         speed, noise, bias_instability, rate_random_walk, quantum, full_scale, b)
     _refuse_reference_flags(ctx, reference)
-    if device and reference is not None:
-        raise InputError("--reference writes a second log; it does not go with --device (leave one out)")
     if device:
-        return _serve_device(protocol, speed, turns, wait, misalignment, k, b, noise, noise_density, sample_rate,
-                             seed, wire, faults, pace)
-    _refuse_device_flags(ctx)
+        return serve_device(ctx, protocol, model=(k, b), speed=speed, turns=turns, wait=wait, misalignment=misalignment,
+                            noise=(noise, noise_density), sample_rate=sample_rate, seed=seed, wire=wire, faults=faults,
+                            pace=pace, poses=poses, still=still)
+    refuse_device_flags(ctx)
     truth_file = _check_outputs(output, truth_path(output) if output else None, reference, profile, force)
     unit = output_unit(units, sensitivity)
     rng = np.random.default_rng(seed)
@@ -247,13 +247,6 @@ def _check_outputs(output: Path | None, truth_file: Path | None, reference: Path
     return truth_file
 
 
-def _refuse_device_flags(ctx: typer.Context) -> None:
-    """--wire, --faults and --pace describe a served device: refuse them without --device."""
-    for name in ("wire", "faults", "pace"):
-        if given(ctx, name):
-            raise InputError(f"--{name} is for --device only; add --device or leave --{name} out")
-
-
 def _refuse_reference_flags(ctx: typer.Context, reference: Path | None) -> None:
     """A --ref-* flag without --reference would be silently ignored: refuse it."""
     if reference is not None:
@@ -293,41 +286,6 @@ def _time_defects(rec, facts, settings, stamps, late_per_minute, gaps, gap_lengt
                                              gaps=gaps, gap_length=gap_length)
     settings.update(more)
     return rec, facts
-
-
-def _serve_device(protocol, speed, turns, wait, misalignment, k, b, noise, noise_density, sample_rate, seed, wire,
-                  faults, pace) -> None:
-    """``simulate --device``: a simulated session served on a pseudo-terminal until it is read to the end."""
-    import numpy as np
-
-    from ..capture.device import VirtualDevice, damage, device_bytes, parse_faults
-    from ..capture.simulated import simulate_device_session
-    from ..models import ScaleBias
-    from ..simulation.servo import ServoProtocol
-
-    if protocol not in _SERVO:
-        raise InputError(f"--device serves servo or hand sessions, got --protocol {protocol}")
-    if not pace >= 0:
-        raise InputError(f"--pace must be >= 0, got {pace!r}")
-    fault = parse_faults(faults, seed)
-    turn_list = tuple(t.strip() for t in turns.split(",") if t.strip())
-    kw = dict(speed=math.radians(speed), wait=wait, misalignment_deg=misalignment, lead_in=3.0)
-    proto = ServoProtocol.hand(turn_list, **kw) if protocol == "hand" else ServoProtocol(turns=turn_list, **kw)
-    sd = noise_std(noise, noise_density, sample_rate, 0.01)
-    model = ScaleBias(triple("--k", k, (1.0, 1.0, 1.0)), b)
-    session = simulate_device_session(proto, model=model, noise_std=sd, rng=np.random.default_rng(seed),
-                                      sample_rate=sample_rate)
-    data, _ = damage(device_bytes(session, wire), fault)
-    rate = None if pace == 0 else len(data) / (len(session) / sample_rate) * pace
-    with VirtualDevice(data, faults=fault, byte_rate=rate, wait_for="reader") as dev:
-        port = dev.start()
-        console.print(f"virtual device on {port}: {protocol} session, {len(session)} samples "
-                      f"({len(session) / sample_rate:.0f} s at {sample_rate:g} Hz), {wire}; it starts when a reader "
-                      f"opens the port, e.g.\n  gyrocal capture --port {port} -o rec.csv --guide {protocol}",
-                      highlight=False, soft_wrap=True, markup=False)
-        while not dev.wait(1.0):
-            pass
-    console.print(f"sent {dev.sent:,} bytes; the device closed the link", highlight=False)
 
 
 def _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misalignment, sample_rate, rng, settings,
