@@ -8,7 +8,8 @@ CSV ``t, gx, gy, gz`` in deg/s to a temporary folder, then times in the same pro
 
 * baseline: ``pyarrow.csv.read_csv(path)``, the parse alone;
 * gyrocal: ``read_recording`` + ``calibrate(--speed 60)`` (which segments), with the
-  segmentation also timed on its own.
+  segmentation also timed on its own, and the calibration also with the straightforward
+  implementations its fast paths replaced (``tests/naive_selfcheck.py``).
 
 Baseline and pipeline runs alternate; prints the best of `repeat` runs of each, the ratio
 to the baseline (target <= 1.5), and each run's ratio to the parse just before it.
@@ -18,11 +19,15 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+import naive_selfcheck  # noqa: E402  (the straightforward calibration, for the before/after line)
 
 
 def best_time(fn, repeat: int) -> tuple[float, object]:
@@ -86,11 +91,15 @@ def main() -> None:
         t_read, rec = best_time(lambda: read_recording(path, units="deg/s"), args.repeat)
         t_seg, seg = best_time(lambda: segment(rec, reference="speed", speed=speed), args.repeat)
         t_cal, _ = best_time(lambda: calibrate(rec, speed=speed), args.repeat)
+        with naive_selfcheck.installed():  # the straightforward implementations the fast paths replaced
+            t_naive, _ = best_time(lambda: calibrate(rec, speed=speed), args.repeat)
 
     print(f"pyarrow.csv.read_csv alone      {parse:7.3f} s   (baseline)")
     print(f"read_recording                  {t_read:7.3f} s   {t_read / parse:5.2f}x")
     print(f"segment (speed reference)       {t_seg:7.3f} s   {t_seg / parse:5.2f}x")
     print(f"calibrate (segment + fit)       {t_cal:7.3f} s   {t_cal / parse:5.2f}x")
+    print(f"  the same, straightforward     {t_naive:7.3f} s   {t_naive / parse:5.2f}x   (tests/naive_selfcheck.py: "
+          f"{t_naive / t_cal:.1f}x the time)")
     print(f"read + segment + calibrate      {full:7.3f} s   {full / parse:5.2f}x   (target <= 1.5)")
     print("paired ratios (each run against the parse just before it): " + ", ".join(f"{r:.2f}" for r in pairs))
     print(f"{len(seg.rotations)} rotations, {len(seg.statics)} static windows; k = "

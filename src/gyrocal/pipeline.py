@@ -331,8 +331,8 @@ def _observed(rec: Recording, tb: TimeBase, noise_std, input_scale: float, input
     """
     # up to 20 000 evenly spread samples (every 50 ms at 1 kHz: a turn's rate lasts longer); the order of
     # magnitude is what a unit check needs
-    sample = rec.gyro[:: max(1, len(rec) // 20_000)]
-    peak = np.array([max(float(c.max()), -float(c.min())) for c in sample.T])
+    sample = np.ascontiguousarray(rec.gyro[:: max(1, len(rec) // 20_000)].T)  # one row per axis, one pass
+    peak = np.maximum(sample.max(axis=1), -sample.min(axis=1))
     return {"sample_rate": rec.sample_rate, "units": input_units,
             "noise_std": (np.asarray(noise_std, dtype=float) / input_scale).tolist(),
             "max_abs_rate": (peak / input_scale).tolist(), "time_base": tb.to_document(),
@@ -354,6 +354,8 @@ def _spread_blocks(gyro: np.ndarray, sample_rate: float, most: int = 200) -> np.
     if blocks <= most:
         return gyro
     pick = np.linspace(0, blocks - 1, most).astype(np.intp)
+    if gyro.flags.f_contiguous:  # as read: each axis's blocks are contiguous, and so are the result's columns
+        return np.array([c[: blocks * size].reshape(blocks, size)[pick].ravel() for c in gyro.T]).T
     return gyro[: blocks * size].reshape(blocks, size, gyro.shape[1])[pick].reshape(-1, gyro.shape[1])
 
 

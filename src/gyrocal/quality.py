@@ -133,7 +133,7 @@ def assess_fit(residuals: Sequence[Sequence[float]], labels: Sequence[str], n_pa
     chi2 = float(per_window.sum())
     rows = sum(len(r) for r in z)
     dof = rows - n_params
-    zs = tuple(tuple(float(v) for v in r) for r in z)
+    zs = tuple(tuple(r.tolist()) for r in z)
     if dof <= 0:
         note = (f"no residual degrees of freedom: {rows} equations for {n_params} parameters, so nothing checks "
                 f"{what} against each other; add static windows or repeat turns to let the fit check itself")

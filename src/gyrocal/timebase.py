@@ -25,7 +25,7 @@ import numpy as np
 
 from .errors import InputError
 from .timegaps import LATE_STEP as _LATE_STEP
-from .timegaps import Gap, find_gaps, residual
+from .timegaps import Gap, find_gaps
 
 __all__ = ["Gap", "TimeBase", "analyse_time", "nominal_period"]
 
@@ -182,10 +182,15 @@ def _residual_floors(t: np.ndarray, period: float, size: int, lost=None) -> tupl
     """:func:`_floors` of the clock residual (less the samples `lost` up to each sample: a function of
     ``lo, hi`` giving them for samples ``lo:hi``), computed a cache-sized stretch of whole blocks at a time."""
     stretch = size * max(1, _STRETCH // size)
+    numbers = np.arange(min(stretch, len(t)), dtype=float)
+    clock, r = np.empty(len(numbers)), np.empty(len(numbers))
 
     def stretch_of(lo: int, hi: int) -> np.ndarray:
-        r = residual(t, period, lo, hi)
-        return r if lost is None else r - period * lost(lo, hi)
+        # gyrocal.timegaps.residual(t, period, lo, hi), in the same operations, into buffers kept in the cache
+        m = hi - lo
+        np.multiply(np.add(numbers[:m], lo, out=clock[:m]), period, out=clock[:m])
+        np.subtract(np.subtract(t[lo:hi], t[0], out=r[:m]), clock[:m], out=r[:m])
+        return r[:m] if lost is None else r[:m] - period * lost(lo, hi)
 
     parts = [_floors(stretch_of(lo, min(lo + stretch, len(t))), size) for lo in range(0, len(t), stretch)]
     return (np.concatenate([v for v, _ in parts]),
@@ -195,9 +200,10 @@ def _residual_floors(t: np.ndarray, period: float, size: int, lost=None) -> tupl
 def _steps(t: np.ndarray):
     """The steps of `t` a cache-sized stretch at a time (no array of every step)."""
     n = len(t) - 1
+    step = np.empty(min(n, _STRETCH))  # one buffer, kept in the cache
     for a in range(0, n, _STRETCH):
         b = min(a + _STRETCH, n)
-        yield t[a + 1:b + 1] - t[a:b]
+        yield np.subtract(t[a + 1:b + 1], t[a:b], out=step[:b - a])
 
 
 def _step_range(t: np.ndarray) -> tuple[float, float]:

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import numpy as np
 import pyarrow as pa
-import pyarrow.compute as pc
 
 __all__ = ["from_numpy", "numeric_to_numpy", "text_to_numpy"]
 
@@ -40,6 +39,8 @@ def numeric_to_numpy(column, out: np.ndarray | None = None, copy: bool = True) -
     for chunk in _chunks(column):
         view = _plain(chunk)
         if view is None:
+            import pyarrow.compute as pc  # only for columns with nulls or not float: its import is 0.1 s
+
             view = np.asarray(pc.fill_null(pc.cast(chunk, pa.float64()), np.nan).to_pylist(), dtype=float)
         parts.append(view)
     if out is None:
@@ -53,6 +54,8 @@ def numeric_to_numpy(column, out: np.ndarray | None = None, copy: bool = True) -
 
 def text_to_numpy(column, dtype=object) -> np.ndarray:
     """A text column as a numpy array of `dtype` (object: Python strings, None for a missing cell)."""
+    import pyarrow.compute as pc  # lazily: numeric logs never need it, and its import is 0.1 s
+
     n = len(column)
     encoded = pc.dictionary_encode(column)
     chunks = _chunks(encoded)

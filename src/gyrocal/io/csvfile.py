@@ -174,17 +174,20 @@ def _read_arrow(path: Path, packed: str | None, layout: Layout, mapping: dict, e
     def read(as_float: bool, encoding: str = "utf8") -> dict[str, list]:
         types = {n: (pa.float64() if as_float and n in numeric else pa.string()) for n in names}
         pieces: dict[str, list] = {n: [] for n in names}
+        options = {
+            # our stripped names replace the header row
+            "read_options": pcsv.ReadOptions(skip_rows=layout.data, column_names=names, encoding=encoding,
+                                             block_size=1 << 24),
+            "parse_options": pcsv.ParseOptions(delimiter=layout.delimiter, ignore_empty_lines=True),
+            "convert_options": pcsv.ConvertOptions(column_types=types, strings_can_be_null=False,
+                                                   decimal_point="," if layout.decimal_comma else "."),
+        }
         with arrow_input(path, packed) as source:
-            reader = pcsv.open_csv(
-                source,
-                # our stripped names replace the header row
-                read_options=pcsv.ReadOptions(skip_rows=layout.data, column_names=names, encoding=encoding,
-                                              block_size=1 << 24),
-                parse_options=pcsv.ParseOptions(delimiter=layout.delimiter, ignore_empty_lines=True),
-                convert_options=pcsv.ConvertOptions(column_types=types, strings_can_be_null=False,
-                                                    decimal_point="," if layout.decimal_comma else "."),
-            )
-            for batch in reader:
+            # numbers only: the whole table at once, its blocks parsed on every core (the streaming reader
+            # parses on one); the numbers are held once by pyarrow and once joined, as when streamed
+            all_numbers = all(t == pa.float64() for t in types.values())
+            batches = pcsv.read_csv(source, **options).to_batches() if all_numbers else pcsv.open_csv(source, **options)
+            for batch in batches:
                 for n, column in zip(names, batch.columns):
                     pieces[n].append(_piece(column, n))
         return pieces

@@ -50,12 +50,12 @@ class _View:
 
 def _upsample(w: Window, *, d: int, n: int, total: int, fs: float, reference: str) -> Window:
     """A window found on blocks of `d` samples, in recording samples (the last block takes the tail)."""
-    w = dataclasses.replace(w, start=w.start * d, stop=total if w.stop >= n else w.stop * d)
+    start, stop = w.start * d, total if w.stop >= n else w.stop * d
     if w.kind != "rotation" or math.isnan(w.rate):
-        return w
+        return dataclasses.replace(w, start=start, stop=stop)
     if reference == "angle":
-        return dataclasses.replace(w, rate=w.angle * fs / len(w))
-    return dataclasses.replace(w, angle=w.rate * len(w) / fs)
+        return dataclasses.replace(w, start=start, stop=stop, rate=w.angle * fs / (stop - start))
+    return dataclasses.replace(w, start=start, stop=stop, angle=w.rate * (stop - start) / fs)
 
 
 def _statics(n: int, fs: float, busy: np.ndarray, trim_s: float, min_s: float, smooth: int):
