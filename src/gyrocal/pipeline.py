@@ -24,15 +24,17 @@ import numpy as np
 
 from .calibration import Calibration
 from .errors import InputError
-from .estimators import FitResult, make_estimator, window_residuals
+from .estimators import FitResult, make_estimator
+from .fit_checks import check_fit
 from .observations import Observation, ObservationSet
 from .observed import quiet_noise
-from .plausibility import Context, check_plausibility
-from .quality import GoodnessOfFit, assess_fit
+from .plausibility import Context
+from .quality import GoodnessOfFit
 from .recording import Recording
 from .screening import require_constant_rate, screen_gaps
 from .segmentation import Segmentation, segment, standstill_level
 from .timebase import TimeBase
+from .turn_angle import wander_ratios
 from .units import parse_input_unit, parse_rate_unit, unit_factor
 from .window_stats import observe_windows
 from .windows import Window
@@ -295,17 +297,22 @@ def calibrate(
                              if (w.start, w.stop) in angle_var else o for w, o in zip(used, observations))
     obs_set = ObservationSet.from_observations(observations)
     fit = estimator.fit(obs_set)
+    if checks and uses_static and reference == "angle":  # a wandering axis: the integral is not the rotation
+        ratio = wander_ratios(rec.gyro, rec.t if times is None else times, used, fit.model.k, fit.model.b,
+                              rec.sample_rate)
+        if np.any(np.abs(ratio - 1) > 1e-9):
+            observations = tuple(dataclasses.replace(o, rate=o.rate * c) for o, c in zip(observations, ratio))
+            obs_set = ObservationSet.from_observations(observations)
+            fit = estimator.fit(obs_set)
     quality, warnings, notes = None, [], []
     if checks:
-        quality = assess_fit(window_residuals(fit, obs_set), [_label(w) for w in used], len(fit.model.params),
-                             what="the turns and static windows" if uses_static else "the turns")
-        if quality.covariance_scaled and fit.covariance is not None:
-            fit = dataclasses.replace(fit, covariance=fit.covariance * quality.birge_ratio**2)
         ctx = Context(units=input_units, counts_scale=rec.units == "counts", reference=reference,
                       declared=value if windows is None or reference == "speed" else math.nan,
                       sample_rate=rec.sample_rate, has_time=rec.has_time, sensitivity=rec.sensitivity)
-        plausible, notes = check_plausibility(fit.model.k, ctx)
-        warnings = list(quality.warnings) + _single_turns(used, reference, value) + plausible
+        scale = _input_scale(input_units, rec.sensitivity, out_units)
+        fit, obs_set, quality, warnings, notes = check_fit(fit, obs_set, estimator, [_label(w) for w in used],
+                                                           reference=reference, ctx=ctx, input_scale=scale)
+        warnings[1 if quality.warnings else 0:0] = _single_turns(used, reference, value)
     cal = Calibration(
         model=fit.model,
         input_units=input_units,
@@ -337,6 +344,13 @@ def _observed(rec: Recording, tb: TimeBase, noise_std, input_scale: float, input
             # the noise of the quiet stretches, measured as apply measures the data it corrects
             "quiet_noise_std": (quiet_noise(_spread_blocks(rec.gyro, rec.sample_rate), rec.sample_rate)
                                 / input_scale).tolist()}
+
+
+def _input_scale(input_units: str, sensitivity, output_units: str) -> float:
+    """Internal units per input unit (:attr:`gyrocal.calibration.Calibration.input_scale`)."""
+    if input_units == "counts":
+        return 1.0 if sensitivity is None else unit_factor(output_units) / sensitivity
+    return unit_factor(input_units)
 
 
 def _spread_blocks(gyro: np.ndarray, sample_rate: float, most: int = 200) -> np.ndarray:

@@ -8,11 +8,14 @@
   the longest plateau (all plateaus run at the declared speed), by
   :func:`gyrocal.longrun.find_lines`.
 * With ``long_run=True`` the variance of each window mean holds for correlated noise and what
-  is left of the ripple: one long-run (Newey-West) variance per axis is pooled over the
-  plateaus' residuals, and one over the static windows (sensor noise at standstill is one
-  process; a variance estimated window by window would scatter, and its inverse read the
-  windows as disagreeing more than they do). A whole turn (angle reference) keeps white noise
-  pooled by the estimator, since its integral is exact whatever the speed did.
+  is left of the ripple. The static windows pool one long-run (Newey-West) variance per axis
+  (sensor noise at standstill is one process; a variance estimated window by window would
+  scatter, and its inverse read the windows as disagreeing more than they do). A whole turn
+  (angle reference) integrates the same sensor noise, so its mean takes that long-run variance
+  too: a chip's internal low-pass filter makes successive samples alike, and the white noise of
+  first differences then understates a turn's angle noise (twenty times at 1 kHz behind a 41 Hz
+  filter). The plateaus' residuals hold the sensor noise and the servo's bounded angle error
+  (vibration), which :func:`gyrocal.longrun.span_variance` separates.
 
 The plateau and static statistics work on block means at about 200 Hz: the same level, the
 same variance of the mean, a fifth of the work at 1 kHz.
@@ -24,7 +27,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .longrun import block_means, find_lines, fit_level, newey_west_var
+from .longrun import block_means, find_lines, fit_level, newey_west_var, span_variance
 from .observations import Observation, observe
 from .recording import Recording
 from .windows import Window
@@ -47,7 +50,7 @@ def _observe(rec: Recording, w: Window, reference: str, speed, times, **stats) -
         return observe(samples, rec.sample_rate, "static", t=t, **stats)
     if reference == "speed":
         return observe(samples, rec.sample_rate, "speed", speed=speed, t=t, **stats)
-    return observe(samples, rec.sample_rate, "angle", angle=w.angle, t=t)
+    return observe(samples, rec.sample_rate, "angle", angle=w.angle, t=t, mean_var=stats.get("mean_var"))
 
 
 #: Block-mean samples enough for a pooled long-run variance (about 3 % precision); whole windows,
@@ -100,6 +103,7 @@ def _window_stats(rec: Recording, windows: Sequence[Window], reference: str, tim
     span = {i: (-(-w.start // d), w.stop // d) for i, w in enumerate(windows)}
     blocks = {i: gyro[a:b] for i, (a, b) in span.items() if b - a >= 4}
     plateaus = [i for i in blocks if windows[i].kind == "rotation" and reference == "speed"]
+    turns = [i for i, w in enumerate(windows) if w.kind == "rotation" and reference == "angle"]
     statics = [i for i in blocks if windows[i].kind == "static"]
     lines: list[float] = []
     if ripple and plateaus:
@@ -114,11 +118,13 @@ def _window_stats(rec: Recording, windows: Sequence[Window], reference: str, tim
         if ripple:
             out[i] = {"level": level}
     if long_run and plateaus:
-        lrv = _pooled_lrv([resid[i] for i in plateaus])
+        a, b = span_variance([resid[i] for i in plateaus])
         for i in plateaus:
-            out.setdefault(i, {})["mean_var"] = lrv * factor[i]
+            out.setdefault(i, {})["mean_var"] = b * factor[i] + a * factor[i] ** 2
     if long_run and statics:
         lrv = _pooled_lrv([blocks[i] - blocks[i].mean(axis=0) for i in statics])
         for i in statics:
             out[i] = {"mean_var": lrv / len(blocks[i])}
+        for i in turns:  # the turn's mean integrates the same sensor noise over its length
+            out[i] = {"mean_var": lrv * d / len(windows[i])}
     return out

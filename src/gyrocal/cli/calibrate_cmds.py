@@ -103,7 +103,8 @@ def _windows_from_file(path: Optional[Path], rec):
         return None
     from ..io import read_windows
 
-    return read_windows(path, sample_rate=rec.sample_rate, t0=float(rec.t[0]), n_samples=len(rec))
+    return read_windows(path, sample_rate=rec.sample_rate, t0=float(rec.t[0]), n_samples=len(rec),
+                        t=rec.t if rec.has_time else None)
 
 
 def _example_paths() -> tuple[Path, Path]:
