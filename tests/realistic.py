@@ -27,7 +27,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.signal import butter, lfilter
 
 D2R = math.pi / 180.0
 EARTH = 7.2921159e-5 / D2R  # [deg/s]
@@ -183,6 +182,8 @@ def _profile(turn: Turn, fs: float, rng: np.random.Generator) -> np.ndarray:
         w = 2 * np.pi * turn.ripple_hz
         ang += turn.ripple * v / w * (np.sin(w * t + phase) - np.sin(phase)) * taper
     if turn.jitter_deg:  # servo vibration: a bounded random angle error, tapered to zero at the ends
+        from scipy.signal import butter, lfilter
+
         b, a = butter(2, 8.0 / (fs / 2))
         e = lfilter(b, a, rng.normal(size=len(t)))
         ang += turn.jitter_deg * e / e.std() * taper
@@ -244,6 +245,8 @@ def motion(plan, fs: float, rng: np.random.Generator, *, latitude: float = 48.0)
 
 def _ou(n: int, dt: float, sd: float, tau: float, rng: np.random.Generator) -> np.ndarray:
     """Ornstein-Uhlenbeck samples (n, 3) with stationary sd `sd` and correlation time `tau`."""
+    from scipy.signal import lfilter
+
     a = math.exp(-dt / tau)
     e = rng.normal(scale=sd * math.sqrt(1 - a * a), size=(n, 3))
     x = np.empty((n, 3))
@@ -254,6 +257,8 @@ def _ou(n: int, dt: float, sd: float, tau: float, rng: np.random.Generator) -> n
 def sense(gyro: Gyro, rate_tool: np.ndarray, fs_int: float, decim: int, rng: np.random.Generator,
           temp: np.ndarray | None = None) -> np.ndarray:
     """The chip's readings [deg/s, quantised] at its output rate from the tool-frame rate on its internal grid."""
+    from scipy.signal import butter, lfilter
+
     m = rate_tool @ gyro.matrix(rng).T
     n = len(m)
     m = m + rng.normal(scale=gyro.noise_density * math.sqrt(fs_int), size=(n, 3))

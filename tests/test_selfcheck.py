@@ -136,6 +136,28 @@ def test_no_degrees_of_freedom_is_said(rng):
                             "turns against each other; add static windows or repeat turns to let the fit check itself",)
 
 
+def test_angles_on_a_counted_time_base_are_flagged(rng):
+    """The chip's clock 0.5 % fast, the time column its sample counter times 10 ms (the generator of
+    tests/realistic.py): every k reads 0.5 % low, a hundred of its 1-sigma, and nothing in the data can
+    tell. The calibration says what its angles rest on; the same log stamped by a PC on receipt is
+    right, and says nothing."""
+    import dataclasses
+
+    import realistic as R
+
+    gyro = dataclasses.replace(R.GYROS[0], clock_error=0.005)
+    plan = [item for j in range(3) for s in (1, -1)
+            for item in (R.Turn(tuple(np.eye(3)[j]), s * 360.0, 60.0), R.Pause(3.0))]
+    for stamps in ("sensor", "receive"):
+        log = R.record(plan, gyro, stamps=stamps, seed=1)
+        rec = Recording(t=log.stamps, gyro=np.radians(log.gyro))
+        run = calibrate(rec, angle=2 * math.pi)
+        off = np.abs(run.fit.model.k - log.k_eff) / run.fit.std[:3]
+        said = any("a sample counter times the nominal rate" in w for w in run.warnings)
+        assert (said and np.all(off > 20)) if stamps == "sensor" else (not said and np.all(off < 4))
+    assert calibrate(rec, speed=math.radians(60)).warnings == ()  # a known speed needs no time base
+
+
 def test_a_wrong_declared_sample_rate_is_named(rng):
     """A 20 Hz log declared 25 Hz (no time column): every turn reads 20 % short; the warning says so."""
     rec, _ = simulate_servo(GYRO, ServoProtocol(speed=math.radians(25)), sample_rate=20, rng=rng)
@@ -214,7 +236,8 @@ def test_counts_print_their_implied_sensitivity_and_skip_the_re_poses(rng):
     counts = Recording(t=rec.t, gyro=np.round(rec.gyro * 16.4 * 180 / math.pi), units="counts", source_units="counts")
     run = calibrate(counts, angle=2 * math.pi)
     assert [w.label for w in run.segmentation.rotations] == list(PAPER_TURNS)
-    assert run.warnings == ()
+    # the only warning: the simulator's time column counts samples at 200 Hz, so k is as good as that rate
+    assert len(run.warnings) == 1 and "a sample counter times the nominal rate" in run.warnings[0]
     assert len(run.notes) == 1 and "sensitivity of 16." in run.notes[0]
     assert "+-2000 deg/s = 16.4 LSB/(deg/s) (InvenSense, Bosch)" in run.notes[0]
 

@@ -17,10 +17,11 @@ extra variance, as random-effects averages do (Paule and Mandel, J. Res. NBS 87,
 * static windows: one extra variance of the level per axis [reading units^2].
 
 Each is the value at which the group's chi-square equals its degrees of freedom
-(``nu = sum over the group of (1 - leverage)``), zero when the group already fits within its
-noise. Estimated from ``nu`` degrees of freedom, it makes errors over the 1-sigma follow
+(``nu = sum over the group of (1 - leverage)``). It is looked for only where the group's
+noise-only chi-square says the noise does not explain it (p < 0.05): below that, a few
+degrees of freedom would widen clean fits at random. Estimated from ``nu`` degrees of freedom, it makes errors over the 1-sigma follow
 Student's t rather than a normal law (variance ``nu / (nu - 2)``, 1.3 for the 9 of a robot's
-twelve turns), so it is carried as ``nu / (nu - 2)`` times itself (twice below ``nu = 4``).
+twelve turns), so it is carried as ``nu / (nu - 2)`` times itself (1.5 times below ``nu = 6``, where the estimate is too rough to say more).
 The fit is repeated with these variances until they settle, so the 1-sigma of every parameter
 includes them and the rows are weighted by what they really know.
 """
@@ -40,6 +41,8 @@ from .observations import ObservationSet
 __all__ = ["Excess", "GroupFit", "widen"]
 
 _ITERATIONS = 6
+#: A group whose noise-only chi2 has a p-value at or above this keeps its noise alone.
+EVIDENCE_P = 0.05
 _SETTLED = 0.01  # relative change of every extra variance at which the iteration stops
 
 
@@ -115,8 +118,8 @@ def _leverage(J: np.ndarray, var: np.ndarray) -> np.ndarray:
 
 
 def _t_factor(dof: float) -> float:
-    """``nu / (nu - 2)``, the variance of Student's t over that of the normal law, capped at 2 (nu <= 4)."""
-    return dof / (dof - 2) if dof > 4 else 2.0
+    """``nu / (nu - 2)``, the variance of Student's t over that of the normal law, capped at 1.5 (nu <= 6)."""
+    return dof / (dof - 2) if dof > 6 else 1.5
 
 
 def _solve_tau2(r2: np.ndarray, v: np.ndarray, c: np.ndarray, dof: float) -> float:
@@ -133,6 +136,18 @@ def _solve_tau2(r2: np.ndarray, v: np.ndarray, c: np.ndarray, dof: float) -> flo
         else:
             hi = mid
     return 0.5 * (lo + hi)
+
+
+def _beyond_noise(z2: np.ndarray, h: np.ndarray, n_rot: int, axis: np.ndarray) -> np.ndarray:
+    """Which groups (turns; static levels of x, y, z) have a noise-only chi2 with p < `EVIDENCE_P` (4,)."""
+    from scipy.special import chdtrc
+
+    parts = [slice(0, n_rot)] + [n_rot + np.flatnonzero(axis == j) for j in range(3)]
+    out = np.zeros(4, dtype=bool)
+    for g, rows in enumerate(parts):
+        dof = float(np.sum(1 - h[rows]))
+        out[g] = dof > 0.5 and float(chdtrc(dof, float(np.sum(z2[rows])))) < EVIDENCE_P
+    return out
 
 
 def _with_extra(obs: ObservationSet, base_mean_var: np.ndarray, base_rate_var: np.ndarray, tau2_turn: float,
@@ -179,6 +194,7 @@ def widen(fit: FitResult, obs: ObservationSet, estimator, reference: str) -> tup
     count_sta = np.repeat(obs.count[obs.static], 3)
     tau_turn, tau_sta = 0.0, np.zeros(3)
     groups: tuple[GroupFit, ...] = ()
+    seen = np.zeros(4, dtype=bool)  # which groups (turns, static x, y, z) scatter beyond their noise
     current, cur_obs = fit, obs
     for step in range(_ITERATIONS):
         r, J, var = _rows(current.model.params, cur_obs, noise_var)
@@ -188,15 +204,17 @@ def widen(fit: FitResult, obs: ObservationSet, estimator, reference: str) -> tup
             groups = (GroupFit("turns", float(np.sum(r2[:n_rot] / var[:n_rot])), float(np.sum(1 - h[:n_rot])), n_rot),
                       GroupFit("static levels", float(np.sum(r2[n_rot:] / var[n_rot:])),
                                float(np.sum(1 - h[n_rot:])), len(r2) - n_rot))
+            seen = _beyond_noise(r2 / var, h, n_rot, axis)
         # the variances without the extra parts, so each solve finds the whole extra variance again
         k2 = np.square(current.model.k)[axis]
         v_turn = var[:n_rot] - c_turn * tau_turn
         v_sta = var[n_rot:] - k2 * count_sta * tau_sta[axis]
         dof_turn = float(np.sum(1 - h[:n_rot]))
-        new_turn = _solve_tau2(r2[:n_rot], v_turn, c_turn, dof_turn) * _t_factor(dof_turn)
+        new_turn = _solve_tau2(r2[:n_rot], v_turn, c_turn, dof_turn) * _t_factor(dof_turn) if seen[0] else 0.0
         dof_sta = [float(np.sum(1 - h[n_rot:][axis == j])) for j in range(3)]
         new_sta = np.array([_solve_tau2(r2[n_rot:][axis == j], v_sta[axis == j], (k2 * count_sta)[axis == j],
-                                        dof_sta[j]) * _t_factor(dof_sta[j]) for j in range(3)])
+                                        dof_sta[j]) * _t_factor(dof_sta[j]) if seen[1 + j] else 0.0
+                            for j in range(3)])
         settled = (abs(new_turn - tau_turn) <= _SETTLED * max(new_turn, 1e-300)
                    and np.all(np.abs(new_sta - tau_sta) <= _SETTLED * np.maximum(new_sta, 1e-300)))
         tau_turn, tau_sta = new_turn, new_sta

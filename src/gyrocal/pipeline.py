@@ -308,7 +308,8 @@ def calibrate(
     if checks:
         ctx = Context(units=input_units, counts_scale=rec.units == "counts", reference=reference,
                       declared=value if windows is None or reference == "speed" else math.nan,
-                      sample_rate=rec.sample_rate, has_time=rec.has_time, sensitivity=rec.sensitivity)
+                      sample_rate=rec.sample_rate, has_time=rec.has_time, sensitivity=rec.sensitivity,
+                      counted=tb.counted)
         scale = _input_scale(input_units, rec.sensitivity, out_units)
         fit, obs_set, quality, warnings, notes = check_fit(fit, obs_set, estimator, [_label(w) for w in used],
                                                            reference=reference, ctx=ctx, input_scale=scale)
