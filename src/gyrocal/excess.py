@@ -14,7 +14,10 @@ extra variance, as random-effects averages do (Paule and Mandel, J. Res. NBS 87,
 * turns: one extra variance of the reference, ``tau^2``: of the angle [rad^2] for whole turns
   (a robot's or a hand's angle error does not shrink for a longer turn) or of the rate
   [rad^2/s^2] for plateaus at a known speed;
-* static windows: one extra variance of the level per axis [reading units^2].
+* static windows: one extra variance of the level per axis [reading units^2]: the bias wanders
+  between windows (flicker, warming up, the Earth's rate in each pose), and it wanders under the
+  turns as much, so every window's mean carries it; the turns' own extra variance is what is left
+  beyond it.
 
 Each is the value at which the group's chi-square equals its degrees of freedom
 (``nu = sum over the group of (1 - leverage)``). It is looked for only where the group's
@@ -152,12 +155,11 @@ def _beyond_noise(z2: np.ndarray, h: np.ndarray, n_rot: int, axis: np.ndarray) -
 
 def _with_extra(obs: ObservationSet, base_mean_var: np.ndarray, base_rate_var: np.ndarray, tau2_turn: float,
                 tau2_static: np.ndarray, reference: str) -> ObservationSet:
-    """`obs` with the extra variances added to the turns' reference and the static levels."""
+    """`obs` with the extra variances added: the turns' reference, and the bias's wander under every window."""
     rot = ~obs.static
     per_turn = tau2_turn / obs.duration**2 if reference == "angle" else np.full(len(obs.duration), tau2_turn)
     rate_var = base_rate_var + np.where(rot, per_turn, 0.0)
-    mean_var = base_mean_var.copy()
-    mean_var[obs.static] += tau2_static
+    mean_var = base_mean_var + tau2_static  # the bias wanders under every window, turning or not
     return dataclasses.replace(obs, mean_var=mean_var, rate_var=rate_var)
 
 
@@ -196,6 +198,7 @@ def widen(fit: FitResult, obs: ObservationSet, estimator, reference: str) -> tup
     groups: tuple[GroupFit, ...] = ()
     seen = np.zeros(4, dtype=bool)  # which groups (turns, static x, y, z) scatter beyond their noise
     current, cur_obs = fit, obs
+    plain = _with_extra(obs, base_mean_var, base_rate_var, 0.0, np.zeros(3), reference)
     for step in range(_ITERATIONS):
         r, J, var = _rows(current.model.params, cur_obs, noise_var)
         h = _leverage(J, var)
@@ -205,16 +208,18 @@ def widen(fit: FitResult, obs: ObservationSet, estimator, reference: str) -> tup
                       GroupFit("static levels", float(np.sum(r2[n_rot:] / var[n_rot:])),
                                float(np.sum(1 - h[n_rot:])), len(r2) - n_rot))
             seen = _beyond_noise(r2 / var, h, n_rot, axis)
-        # the variances without the extra parts, so each solve finds the whole extra variance again
+        # each extra variance is found again from the variances without it: the static levels' from the noise
+        # alone; the turns' from the noise and the bias's wander, which moves a turn's mean as it moves a level's
         k2 = np.square(current.model.k)[axis]
-        v_turn = var[:n_rot] - c_turn * tau_turn
-        v_sta = var[n_rot:] - k2 * count_sta * tau_sta[axis]
-        dof_turn = float(np.sum(1 - h[:n_rot]))
-        new_turn = _solve_tau2(r2[:n_rot], v_turn, c_turn, dof_turn) * _t_factor(dof_turn) if seen[0] else 0.0
+        v_sta = _rows(current.model.params, plain, noise_var)[2][n_rot:]
         dof_sta = [float(np.sum(1 - h[n_rot:][axis == j])) for j in range(3)]
         new_sta = np.array([_solve_tau2(r2[n_rot:][axis == j], v_sta[axis == j], (k2 * count_sta)[axis == j],
                                         dof_sta[j]) * _t_factor(dof_sta[j]) if seen[1 + j] else 0.0
                             for j in range(3)])
+        wander = _with_extra(obs, base_mean_var, base_rate_var, 0.0, new_sta, reference)
+        v_turn = _rows(current.model.params, wander, noise_var)[2][:n_rot]
+        dof_turn = float(np.sum(1 - h[:n_rot]))
+        new_turn = _solve_tau2(r2[:n_rot], v_turn, c_turn, dof_turn) * _t_factor(dof_turn) if seen[0] else 0.0
         settled = (abs(new_turn - tau_turn) <= _SETTLED * max(new_turn, 1e-300)
                    and np.all(np.abs(new_sta - tau_sta) <= _SETTLED * np.maximum(new_sta, 1e-300)))
         tau_turn, tau_sta = new_turn, new_sta

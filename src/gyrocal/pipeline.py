@@ -34,7 +34,7 @@ from .recording import Recording
 from .screening import require_constant_rate, screen_gaps
 from .segmentation import Segmentation, segment, standstill_level
 from .timebase import TimeBase
-from .turn_angle import wander_ratios
+from .turn_angle import follow_wander
 from .units import parse_input_unit, parse_rate_unit, unit_factor
 from .window_stats import observe_windows
 from .windows import Window
@@ -298,12 +298,8 @@ def calibrate(
     obs_set = ObservationSet.from_observations(observations)
     fit = estimator.fit(obs_set)
     if checks and uses_static and reference == "angle":  # a wandering axis: the integral is not the rotation
-        ratio = wander_ratios(rec.gyro, rec.t if times is None else times, used, fit.model.k, fit.model.b,
-                              rec.sample_rate)
-        if np.any(np.abs(ratio - 1) > 1e-9):
-            observations = tuple(dataclasses.replace(o, rate=o.rate * c) for o, c in zip(observations, ratio))
-            obs_set = ObservationSet.from_observations(observations)
-            fit = estimator.fit(obs_set)
+        observations, obs_set, fit = follow_wander(rec, rec.t if times is None else times, used, observations,
+                                                   obs_set, fit, estimator)
     quality, warnings, notes = None, [], []
     if checks:
         ctx = Context(units=input_units, counts_scale=rec.units == "counts", reference=reference,

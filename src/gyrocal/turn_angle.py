@@ -16,6 +16,7 @@ turntable or a robot joint, whose axis does not wander: turns over 300 deg keep 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 
@@ -23,9 +24,10 @@ import numpy as np
 
 from . import quaternion as quat
 from .longrun import block_means
+from .observations import Observation, ObservationSet
 from .windows import Window
 
-__all__ = ["wander_ratios"]
+__all__ = ["follow_wander", "wander_ratios"]
 
 _RATE = 200.0  # [Hz] block means behind the integration: hand wobbles are far slower
 _LARGEST = math.radians(300.0)  # turns beyond this keep ratio 1 (see the module notes)
@@ -57,7 +59,7 @@ def wander_ratios(gyro: np.ndarray, t: np.ndarray, windows: Sequence[Window], k:
     d = max(1, int(round(sample_rate / _RATE)))
     out = np.ones(len(windows))
     for i, w in enumerate(windows):
-        if w.kind != "rotation" or w.stop - w.start < 4 * d:
+        if w.kind != "rotation" or w.stop - w.start < 4 * d or abs(w.angle) > _LARGEST:  # declared over 300 deg
             continue
         omega = k * (block_means(np.asarray(gyro[w.start:w.stop], dtype=float), d) + b)
         tt = block_means(np.asarray(t[w.start:w.stop], dtype=float), d)
@@ -70,3 +72,17 @@ def wander_ratios(gyro: np.ndarray, t: np.ndarray, windows: Sequence[Window], k:
         if angle > 0:
             out[i] = size / angle
     return out
+
+
+def follow_wander(rec, t: np.ndarray, windows: Sequence[Window], observations: Sequence[Observation],
+                  obs: ObservationSet, fit, estimator):
+    """Whole turns' reference rates times their :func:`wander_ratios` at `fit`, and the refit.
+
+    Returns ``(observations, obs, fit)``: the inputs themselves when every turn kept its axis.
+    """
+    ratio = wander_ratios(rec.gyro, t, windows, fit.model.k, fit.model.b, rec.sample_rate)
+    if not np.any(np.abs(ratio - 1) > 1e-9):
+        return tuple(observations), obs, fit
+    observations = tuple(dataclasses.replace(o, rate=o.rate * c) for o, c in zip(observations, ratio))
+    obs = ObservationSet.from_observations(observations)
+    return observations, obs, estimator.fit(obs)
