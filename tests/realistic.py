@@ -200,12 +200,12 @@ def _perpendicular(u: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     return w / np.linalg.norm(w)
 
 
-def motion(plan, fs: float, rng: np.random.Generator, *, latitude: float = 48.0):
+def motion(plan, fs: float, rng: np.random.Generator, *, latitude: float = 48.0, earth_rate: float = EARTH):
     """Tool-frame angular rate (n, 3) [deg/s] on a grid of `fs` from a list of Turn/Pause, and the segments.
 
     Returns rate, and a list of (kind, start time, stop time, Turn or None, net rotation angle).
     """
-    earth = EARTH * np.array([math.cos(latitude * D2R), 0.0, math.sin(latitude * D2R)])
+    earth = earth_rate * np.array([math.cos(latitude * D2R), 0.0, math.sin(latitude * D2R)])
     att = np.eye(3)  # world <- tool
     pieces, segs, now = [], [], 0.0
     for item in plan:
@@ -350,14 +350,15 @@ def drop(n: int, lengths, rng: np.random.Generator, inside=None) -> np.ndarray:
 
 def record(plan, gyro: Gyro, *, rate: float = 100.0, stamps: str = "receive", per_packet: int = 2,
            gaps=(), gaps_in_turns: bool = True, late_per_minute: float = 4.0, temp_rise: float = 0.0,
-           seed: int = 0, angle_sd: float = 0.05, lead: float = 3.0, unit_seed: int | None = None) -> Log:
+           seed: int = 0, angle_sd: float = 0.05, lead: float = 3.0, unit_seed: int | None = None,
+           earth: bool = True) -> Log:
     """Record `plan` (Turn/Pause list) with `gyro` at nominal `rate` [Hz].
 
     stamps: "receive" (alternating 2-5 / 12-17 ms at 100 Hz), "packets" (USB packets of
     `per_packet`), "sensor" (the chip's counter times its nominal period), "none".
     gaps: lengths [samples] of real packet losses. angle_sd: sd of the robot-measured angle [deg].
     unit_seed: draws the gyro's mounting and non-orthogonality (one physical unit: the same for every
-    recording made with it); default from `seed`.
+    recording made with it); default from `seed`. earth: the Earth's rate in the readings.
     """
     # long function: the recording's stages in order (motion, sensor, clock, stamps, truth), each a call
     rng = np.random.default_rng(seed)
@@ -365,7 +366,7 @@ def record(plan, gyro: Gyro, *, rate: float = 100.0, stamps: str = "receive", pe
     decim = 8
     fs_phys = rate * (1 + gyro.clock_error)  # the chip's actual rate
     fs_int = fs_phys * decim
-    rate_tool, segs = motion([Pause(lead)] + list(plan) + [Pause(lead)], fs_int, rng)
+    rate_tool, segs = motion([Pause(lead)] + list(plan) + [Pause(lead)], fs_int, rng, earth_rate=EARTH if earth else 0.0)
     n_int = len(rate_tool)
     t_int = np.arange(n_int) / fs_int
     temp = None

@@ -69,12 +69,13 @@ def summary(z: list, flagged: list, label: str) -> str:
 
 
 GAPS = True  # packet gaps in the robot logs (--no-gaps: none)
+FIRST = 0  # first robot seed (--first-seed)
 
 
 def robot(seeds: int) -> None:
     """Three gyros x six speeds, windows file from the robot's log (angles 135-270 deg, 0.05 deg error)."""
-    zs, flags = [], []
-    for seed in range(seeds):
+    zs, flags, chis = [], [], []
+    for seed in range(FIRST, FIRST + seeds):
         for g, gyro in enumerate(R.GYROS):
             ks, ss = [], []
             for v in R.SPEEDS:
@@ -89,15 +90,28 @@ def robot(seeds: int) -> None:
                 ss.append(res["sigma"])
                 zs.append(res["z"])
                 flags.append(bool(res["warnings"]))
+                if np.abs(res["z"]).max() > 3:  # the tail, for a look
+                    ex = res["fit"].get("excess") or {}
+                    print(f"  seed {seed} gyro {g} {v:g} deg/s: z " + " ".join(f"{x:.2f}" for x in res["z"])
+                          + f", flagged {bool(res['warnings'])}, turn excess {ex.get('turn_reference_sd', 0):.3g} deg, "
+                          + "groups " + ", ".join(f"{gr['name']} {gr['chi2']:.3g}/{gr['dof']:.3g}" for gr in ex.get("groups", ())))
             if len(ks) < 2:
                 continue
             ks, ss = np.array(ks), np.array(ss)
             w = 1 / ss**2
             mean = (ks * w).sum(0) / w.sum(0)
             chi = (((ks - mean) / ss) ** 2).sum(0) / max(len(ks) - 1, 1)
+            chis += list(chi)
             print(f"  seed {seed} gyro {g}: chi2/dof of k across {len(ks)} speeds (x, y, z) "
                   + " ".join(f"{c:.2f}" for c in chi), flush=True)
     print(summary(zs, flags, "robot"))
+    if chis:
+        from scipy.stats import chi2
+
+        # with 6 speeds, chi2/dof has 5 dof: above 3.02 by chance in 1 % of (gyro, axis) pairs
+        print(f"robot: chi2/dof of k across the speeds over {len(chis)} (gyro, axis) pairs: median {np.median(chis):.2f} "
+              f"(expected {chi2.median(5) / 5:.2f}), max {max(chis):.2f}, above 3.02 (p < 0.01) "
+              f"{100 * np.mean(np.array(chis) > 3.02):.0f} % (expected 1 %)")
 
 
 def _six(speed=60.0, angle=360.0, pause=3.0, **kw) -> list:
@@ -137,19 +151,22 @@ def _tilt_plan(rng, *, wobble: float, hand_sd: float, angle: float = 45.0, off: 
 def hand(seeds: int) -> None:
     """Hand tilts of 45 deg, up to 20 deg off-axis, wobbling axes, uneven speeds, --angle 45."""
     gyro = R.Gyro(k=(1.01, 0.99, 1.005), mount_deg=0.0, cross=0.0)
-    for wobble, hand_sd in ((3.0, 0.0), (3.0, 1.0)):
+    for wobble, hand_sd, listed in ((3.0, 0.0, False), (3.0, 1.0, False), (3.0, 0.0, True), (3.0, 1.0, True)):
         zs, flags = [], []
         for seed in range(seeds):
             rng = np.random.default_rng(seed)
             log = R.record(_tilt_plan(rng, wobble=wobble, hand_sd=hand_sd), gyro, seed=seed, stamps="packets",
                            per_packet=1, angle_sd=0.0)
-            res = calibrate(log, "--units", "deg/s", "--angle", "45")
+            # a windows file as a person writes it: each tilt's span, every angle the intended 45 deg
+            windows = [{**w, "angle_deg": 45.0} if w["kind"] == "rotation" else w for w in log.windows()]
+            res = calibrate(log, "--units", "deg/s", "--angle", "45", windows=windows if listed else None)
             if res["code"]:
                 print(f"  seed {seed}: exit {res['code']}: {res['error'][:160]}")
                 continue
             zs.append(res["z"])
             flags.append(bool(res["warnings"]))
-        print(summary(zs, flags, f"hand tilts, wobble up to {wobble:g} deg, hand angle sd {hand_sd:g} deg"))
+        print(summary(zs, flags, f"hand tilts, wobble up to {wobble:g} deg, hand angle sd {hand_sd:g} deg, "
+                                 + ("windows file" if listed else "detected")))
 
 
 def user_mistakes(seeds: int) -> None:
@@ -266,9 +283,10 @@ def main() -> None:
     parser.add_argument("--scenario", choices=[*SCENARIOS, "all"], default="all")
     parser.add_argument("--seeds", type=int, default=4)
     parser.add_argument("--no-gaps", action="store_true", help="robot logs without packet gaps")
+    parser.add_argument("--first-seed", type=int, default=0, help="robot: first seed")
     args = parser.parse_args()
-    global GAPS
-    GAPS = not args.no_gaps
+    global GAPS, FIRST
+    GAPS, FIRST = not args.no_gaps, args.first_seed
     import gyrocal
 
     print(f"gyrocal from {Path(gyrocal.__file__).parent}")

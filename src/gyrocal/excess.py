@@ -21,7 +21,7 @@ extra variance, as random-effects averages do (Paule and Mandel, J. Res. NBS 87,
 
 Each is the value at which the group's chi-square equals its degrees of freedom
 (``nu = sum over the group of (1 - leverage)``). It is looked for only where the group's
-noise-only chi-square says the noise does not explain it (p < 0.05): below that, a few
+noise-only chi-square gives the noise alone little support (p < 0.1): below that, a few
 degrees of freedom would widen clean fits at random. Estimated from ``nu`` degrees of freedom, it makes errors over the 1-sigma follow
 Student's t rather than a normal law (variance ``nu / (nu - 2)``, 1.3 for the 9 of a robot's
 twelve turns), so it is carried as ``nu / (nu - 2)`` times itself (1.5 times below ``nu = 6``, where the estimate is too rough to say more).
@@ -45,7 +45,7 @@ __all__ = ["Excess", "GroupFit", "widen"]
 
 _ITERATIONS = 6
 #: A group whose noise-only chi2 has a p-value at or above this keeps its noise alone.
-EVIDENCE_P = 0.05
+EVIDENCE_P = 0.1
 _SETTLED = 0.01  # relative change of every extra variance at which the iteration stops
 
 

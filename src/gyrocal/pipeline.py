@@ -97,11 +97,21 @@ class CalibrationRun:
         return (f"{self.calibration.method} reads k low by about {low:.2g} (the noise power in its mean of squares); "
                 "its 1-sigma is the spread only; the first-moment method is unbiased")
 
+    def reference_text(self, speed_unit: str = "deg/s") -> str:
+        """The reference in words: the speed, the one declared angle, or the range a windows file gave."""
+        if self.reference == "speed":
+            from .units import from_rad_s
+
+            return f"speed {from_rad_s(self.reference_value, speed_unit):g} {speed_unit}"
+        angles = {round(math.degrees(w.angle), 6) for w in self.segmentation.rotations}
+        if len(angles) > 1:
+            return f"angles of the windows file, {min(angles):g}-{max(angles):g} deg"
+        return f"angle {angles.pop() if angles else math.degrees(self.reference_value):g} deg per turn"
+
     def report(self) -> str:
         """Plain-text summary: parameters in user units with 1-sigma, and the correction."""
         cal = self.calibration
-        ref = (f"speed {self.reference_value * 180 / math.pi:g} deg/s" if self.reference == "speed"
-               else f"angle {math.degrees(self.reference_value):g} deg per turn")
+        ref = self.reference_text()
         n_rot = sum(w["kind"] == "rotation" for w in cal.windows)
         lines = [
             (f"gyrocal calibration: method {cal.method}, reference {ref}, "

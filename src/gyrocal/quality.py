@@ -179,9 +179,10 @@ def assess_fit(residuals: Sequence[Sequence[float]], labels: Sequence[str], n_pa
     widened_any = excess is not None and excess.any
     flagged = p < P_THRESHOLD or any(g[3] < P_THRESHOLD for g in groups)
     if not flagged:
-        notable = widened_any and any(g[3] < NOTE_P for g in groups)
-        notes = ((f"{what} scatter a little beyond their noise (not enough to flag); the 1-sigma includes "
-                  f"{widened}",) if notable else ())
+        notable = [g for g in groups if g[3] < NOTE_P] if widened_any else []
+        notes = (("; ".join(f"the {name} scatter beyond their noise (chi2 {c:.3g} for {d:.3g} dof, p = {q:.2g})"
+                            for name, c, d, q in notable) + f", not enough to flag; the 1-sigma includes {widened}",)
+                 if notable else ())
         return GoodnessOfFit(chi2, dof, p, birge, widened_any, tuple(labels), zs, excess=doc, notes=notes)
     worst = tuple(int(i) for i in np.argsort(-per_window)[:_NAMED])
     names = ", ".join(_name(i, labels[i], z[i]) for i in worst)
