@@ -21,8 +21,8 @@ import time
 
 import numpy as np
 
+from gyrocal import quaternion as quat
 from gyrocal.imu import calibrate_imu
-from gyrocal.imu import quaternion as quat
 from gyrocal.models import Affine
 from gyrocal.simulation.gyro import VirtualGyro
 from gyrocal.simulation.multiposition import MultiPositionProtocol, VirtualImu, simulate_multi_position

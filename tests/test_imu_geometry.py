@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from gyrocal import quaternion as quat
 from gyrocal.imu import coverage, fibonacci_directions, pose_sequence, triangular_frame
-from gyrocal.imu import quaternion as quat
 
 
 def _scipy(q):

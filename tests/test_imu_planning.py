@@ -49,7 +49,7 @@ def test_accelerometer_prediction_is_the_spread_of_repeated_fits():
 
 
 def pose_dirs(n):
-    from gyrocal.imu import quaternion as quat
+    from gyrocal import quaternion as quat
 
     return quat.rotate(pose_sequence(n, 90.0) * [1, -1, -1, -1], np.array([0.0, 0.0, 1.0]))
 

@@ -124,7 +124,7 @@ def test_too_few_poses_are_refused_with_the_number_needed():
 
 def test_turns_about_two_axes_only_leave_the_third_gyro_axis_undetermined():
     """Every move turns the board about its own x or y axis, never z: the gyro's z response is not determined."""
-    from gyrocal.imu import quaternion as quat
+    from gyrocal import quaternion as quat
 
     q = [np.array([1.0, 0.0, 0.0, 0.0])]
     for k in range(13):

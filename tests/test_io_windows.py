@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 
+import numpy as np
 import pytest
 
 from gyrocal.errors import FileFormatError
@@ -96,3 +97,18 @@ def test_missing_or_empty_windows_file(tmp_path):
     (tmp_path / "h.csv").write_text("start,stop,kind\n")
     with pytest.raises(FileFormatError, match="h.csv: holds no windows"):
         read_windows(tmp_path / "h.csv", sample_rate=100.0)
+
+
+def test_windows_in_seconds_follow_the_time_column_across_a_gap(tmp_path):
+    """A log at 100 Hz that lost 17 samples (a 180 ms packet gap) at 2 s: a window written in seconds after the
+    gap holds the samples stamped inside it (reference: the stamps themselves), not samples 0.17 s later, and
+    one that ends at the log's last stamp is inside it (through the nominal rate it would run past the end)."""
+    t = 100.0 + np.delete(np.arange(1017) / 100.0, np.arange(200, 217))  # 1000 samples, 17 lost at 2.00 s
+    path = tmp_path / "w.json"
+    path.write_text(json.dumps([{"t_start": 105.0, "t_stop": 106.0, "kind": "rotation"},
+                                {"t_start": 109.0, "t_stop": float(t[-1]), "kind": "static"}]))
+    rot, sta = read_windows(path, sample_rate=100.0, t0=float(t[0]), n_samples=len(t), t=t)
+    assert (t[rot.start], t[rot.stop]) == (pytest.approx(105.0), pytest.approx(106.0))
+    assert rot.stop - rot.start == 100 and sta.stop <= len(t)
+    with pytest.raises(FileFormatError, match="past the recording"):
+        read_windows(path, sample_rate=100.0, t0=float(t[0]), n_samples=len(t))  # the nominal rate alone

@@ -89,3 +89,17 @@ def test_bad_time_bases_are_refused():
         analyse_time([0.0])
     with pytest.raises(InputError, match="does not fit"):
         receive_times(10, 1000.0, ReceiveClock(packet=2, read_time=0.004, jitter=0.003), np.random.default_rng(0))
+
+
+def test_packets_of_four_are_a_rhythm_not_late_deliveries(rng):
+    """Four samples per USB packet at 100 Hz: every fourth step is 40 ms, the packets' own rhythm; only a
+    packet held up beyond it is late. Reference: the stamps of the independent generator (tests/realistic.py),
+    which holds up exactly the deliveries it was told to."""
+    import realistic
+
+    t = np.arange(6000) / FS
+    calm = realistic.receive_packets(t, 4, rng, late_per_minute=0.0)
+    assert analyse_time(calm).delayed == 0  # the former rule (any step over 3 periods) counted 1,500
+    held = realistic.receive_packets(t, 4, np.random.default_rng(3), late_per_minute=6.0)
+    tb = analyse_time(held)
+    assert 1 <= tb.delayed <= 6 and not tb.gaps and tb.regular_clock

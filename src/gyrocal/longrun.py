@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["batch_means_var", "block_means", "find_lines", "fit_level", "fit_levels", "newey_west_var", "plateau_mean"]
+__all__ = ["batch_means_var", "block_means", "find_lines", "fit_level", "fit_levels", "newey_west_var", "plateau_mean",
+           "span_variance"]
 
 
 def batch_means_var(x: np.ndarray, batches: int = 10) -> np.ndarray:
@@ -50,6 +51,70 @@ def newey_west_var(x: np.ndarray, lags: int | None = None, *, prewhiten: bool = 
     for h in range(1, lags + 1):
         s = s + 2 * (1 - h / (lags + 1)) * np.einsum("ji,ji->j", d[:, h:], d[:, :-h]) / m
     return np.maximum(s, 0.0) / (1.0 - rho) ** 2 / n
+
+
+#: Shortest span [samples] of the span-variance fit: a servo's vibration decorrelates within it.
+_MIN_SPAN = 8
+
+
+def span_variance(residuals: list[np.ndarray], *, min_span: int = _MIN_SPAN, spans: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    """Long-run variance and bounded-angle variance of residuals, from the variance of their sums over spans.
+
+    A plateau's residual (its level and periodic ripple removed) is sensor noise plus whatever is
+    left of the motion's own error. The sensor's part integrates to a random walk, the motion's is
+    a bounded angle error (a position-controlled servo's vibration: its rate has no zero-frequency
+    power, but lag windows such as Newey-West's count its short-lag covariance and not the negative
+    one beyond, and overstate the plateau's variance many times). The variance of the sum of `L`
+    consecutive residuals separates them: ``V(L) = a + b L`` once `L` exceeds the vibration's
+    correlation time, with ``b`` the long-run variance per sample and ``a`` twice the bounded error's
+    variance. The mean of ``n`` residuals then has variance ``(a + b n) / n^2``.
+
+    Parameters
+    ----------
+    residuals : list of ndarray, shape (n_i, k)
+        Each window's residuals (mean zero within the window).
+    min_span : int
+        Shortest span [samples].
+    spans : int
+        Span lengths, spread geometrically from `min_span` to a third of the shortest window.
+
+    Returns
+    -------
+    a, b : ndarray, shape (k,)
+        ``a`` [units^2 samples^2] and ``b`` [units^2 samples] (per sample of the residuals).
+    """
+    n_min = min(len(r) for r in residuals)
+    top = max(min_span + 1, n_min // 3)
+    lengths = np.unique(np.geomspace(min(min_span, max(1, top - 1)), top, spans).astype(int))
+    k = residuals[0].shape[1]
+    rows, values, weights = [], [], []
+    for L in lengths.tolist():
+        total, count, shrink = np.zeros(k), 0, 0.0
+        for r in residuals:
+            if len(r) <= L:
+                continue
+            c = np.concatenate([np.zeros((1, k)), np.cumsum(r, axis=0)])
+            d = c[L:] - c[:-L]  # every sum of L consecutive residuals
+            total += np.einsum("ij,ij->j", d, d)
+            count += len(d)
+            # removing each window's mean shortens its sums' variance by about (1 - L / n)
+            shrink += len(d) * (1 - L / len(r))
+        if count:
+            rows.append((shrink / count, L * shrink / count))
+            values.append(total / count)
+            weights.append(count / L)  # roughly independent sums of L
+    X, V, w = np.array(rows), np.array(values), np.array(weights)
+    a, b = np.zeros(k), np.zeros(k)
+    for j in range(k):
+        # relative least squares: each V(L) has a relative spread of about sqrt(L / count)
+        sw = np.sqrt(w) / np.maximum(V[:, j], 1e-300)
+        coef = np.linalg.lstsq(X * sw[:, None], V[:, j] * sw, rcond=None)[0]
+        if coef[0] < 0 or coef[1] < 0:  # one term only: the other is not in the data
+            only_b = float(np.sum(sw**2 * X[:, 1] * V[:, j]) / np.sum((sw * X[:, 1]) ** 2))
+            coef = np.array([0.0, only_b]) if coef[0] < 0 else np.array([float(np.sum(sw**2 * X[:, 0] * V[:, j])
+                                                                                  / np.sum((sw * X[:, 0]) ** 2)), 0.0])
+        a[j], b[j] = coef
+    return a, b
 
 
 def _periodogram(y: np.ndarray, pad: int = 4) -> tuple[np.ndarray, np.ndarray]:

@@ -24,15 +24,17 @@ import numpy as np
 
 from .calibration import Calibration
 from .errors import InputError
-from .estimators import FitResult, make_estimator, window_residuals
+from .estimators import FitResult, make_estimator
+from .fit_checks import check_fit
 from .observations import Observation, ObservationSet
 from .observed import quiet_noise
-from .plausibility import Context, check_plausibility
-from .quality import GoodnessOfFit, assess_fit
+from .plausibility import Context
+from .quality import GoodnessOfFit
 from .recording import Recording
 from .screening import require_constant_rate, screen_gaps
 from .segmentation import Segmentation, segment, standstill_level
 from .timebase import TimeBase
+from .turn_angle import follow_wander
 from .units import parse_input_unit, parse_rate_unit, unit_factor
 from .window_stats import observe_windows
 from .windows import Window
@@ -95,11 +97,21 @@ class CalibrationRun:
         return (f"{self.calibration.method} reads k low by about {low:.2g} (the noise power in its mean of squares); "
                 "its 1-sigma is the spread only; the first-moment method is unbiased")
 
+    def reference_text(self, speed_unit: str = "deg/s") -> str:
+        """The reference in words: the speed, the one declared angle, or the range a windows file gave."""
+        if self.reference == "speed":
+            from .units import from_rad_s
+
+            return f"speed {from_rad_s(self.reference_value, speed_unit):g} {speed_unit}"
+        angles = {round(math.degrees(w.angle), 6) for w in self.segmentation.rotations}
+        if len(angles) > 1:
+            return f"angles of the windows file, {min(angles):g}-{max(angles):g} deg"
+        return f"angle {angles.pop() if angles else math.degrees(self.reference_value):g} deg per turn"
+
     def report(self) -> str:
         """Plain-text summary: parameters in user units with 1-sigma, and the correction."""
         cal = self.calibration
-        ref = (f"speed {self.reference_value * 180 / math.pi:g} deg/s" if self.reference == "speed"
-               else f"angle {math.degrees(self.reference_value):g} deg per turn")
+        ref = self.reference_text()
         n_rot = sum(w["kind"] == "rotation" for w in cal.windows)
         lines = [
             (f"gyrocal calibration: method {cal.method}, reference {ref}, "
@@ -297,17 +309,19 @@ def calibrate(
                              if (w.start, w.stop) in angle_var else o for w, o in zip(used, observations))
     obs_set = ObservationSet.from_observations(observations)
     fit = estimator.fit(obs_set)
+    if checks and uses_static and reference == "angle":  # a wandering axis: the integral is not the rotation
+        observations, obs_set, fit = follow_wander(rec, rec.t if times is None else times, used, observations,
+                                                   obs_set, fit, estimator)
     quality, warnings, notes = None, [], []
     if checks:
-        quality = assess_fit(window_residuals(fit, obs_set), [_label(w) for w in used], len(fit.model.params),
-                             what="the turns and static windows" if uses_static else "the turns")
-        if quality.covariance_scaled and fit.covariance is not None:
-            fit = dataclasses.replace(fit, covariance=fit.covariance * quality.birge_ratio**2)
         ctx = Context(units=input_units, counts_scale=rec.units == "counts", reference=reference,
                       declared=value if windows is None or reference == "speed" else math.nan,
-                      sample_rate=rec.sample_rate, has_time=rec.has_time, sensitivity=rec.sensitivity)
-        plausible, notes = check_plausibility(fit.model.k, ctx)
-        warnings = list(quality.warnings) + _single_turns(used, reference, value) + plausible
+                      sample_rate=rec.sample_rate, has_time=rec.has_time, sensitivity=rec.sensitivity,
+                      counted=tb.counted)
+        scale = _input_scale(input_units, rec.sensitivity, out_units)
+        fit, obs_set, quality, warnings, notes = check_fit(fit, obs_set, estimator, [_label(w) for w in used],
+                                                           reference=reference, ctx=ctx, input_scale=scale)
+        warnings[1 if quality.warnings else 0:0] = _single_turns(used, reference, value)
     cal = Calibration(
         model=fit.model,
         input_units=input_units,
@@ -339,6 +353,13 @@ def _observed(rec: Recording, tb: TimeBase, noise_std, input_scale: float, input
             # the noise of the quiet stretches, measured as apply measures the data it corrects
             "quiet_noise_std": (quiet_noise(_spread_blocks(rec.gyro, rec.sample_rate), rec.sample_rate)
                                 / input_scale).tolist()}
+
+
+def _input_scale(input_units: str, sensitivity, output_units: str) -> float:
+    """Internal units per input unit (:attr:`gyrocal.calibration.Calibration.input_scale`)."""
+    if input_units == "counts":
+        return 1.0 if sensitivity is None else unit_factor(output_units) / sensitivity
+    return unit_factor(input_units)
 
 
 def _spread_blocks(gyro: np.ndarray, sample_rate: float, most: int = 200) -> np.ndarray:

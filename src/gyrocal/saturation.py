@@ -36,8 +36,11 @@ def find_saturation(gyro, full_scale: float | None = None, *, min_run: int = MIN
         Sensor limit [same unit as `gyro`]. Readings with ``|m| >= full_scale`` are saturated.
         Without it, a sample is saturated when it belongs to a run of at least `min_run`
         identical readings at the axis's maximum or at its minimum (each tested on its own),
-        and that level's magnitude is more than twice the axis's median magnitude (a quiet,
-        constant axis is not saturated).
+        that level's magnitude is more than twice the axis's median magnitude (a quiet,
+        constant axis is not saturated), and readings pile up there: more than twice as many
+        as at the next level inward. A clipped axis collects every reading beyond its limit;
+        a smooth peak (a chip's low-pass filter at 1 kHz holds a turn's top reading for a few
+        samples) visits its top level about as often as the one below.
     min_run : int
         Shortest run of stuck samples counted when `full_scale` is not given.
 
@@ -63,6 +66,16 @@ def find_saturation(gyro, full_scale: float | None = None, *, min_run: int = MIN
     return stuck_runs(g, g.max(axis=0), g.min(axis=0), int(min_run))
 
 
+def _piles_up(col: np.ndarray, level: float, at_level: int, top: bool) -> bool:
+    """Whether readings pile up at `level`, the top or bottom extreme: more than twice as many as at the next
+    level inward."""
+    inward = col[col < level] if top else col[col > level]
+    if not len(inward):
+        return True
+    nearest = inward.max() if top else inward.min()
+    return at_level > 2 * int(np.count_nonzero(col == nearest))
+
+
 def stuck_runs(g: np.ndarray, hi: np.ndarray, lo: np.ndarray, min_run: int = MIN_RUN) -> np.ndarray:
     """:func:`find_saturation` without a full scale, given each axis's maximum and minimum (3,)."""
     mask = np.zeros(g.shape, dtype=bool)
@@ -77,7 +90,7 @@ def stuck_runs(g: np.ndarray, hi: np.ndarray, lo: np.ndarray, min_run: int = MIN
             if np.count_nonzero(stuck) < min_run:  # the common case: no pile-up at this extreme
                 continue
             runs = _long_runs(stuck, min_run)
-            if runs.any():
+            if runs.any() and _piles_up(col, level, np.count_nonzero(stuck), level == hi[j]):
                 median = np.median(np.abs(col)) if median is None else median  # a sort: only when needed
                 if abs(level) > 2.0 * median:
                     mask[:, j] |= runs

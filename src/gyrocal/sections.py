@@ -194,16 +194,19 @@ class FitQuality(Section):
 
     Documented keys: ``chi2``, ``dof`` (0: no residual degrees of freedom, nothing checked),
     ``chi2_per_dof``, ``p_value`` (null without dof), ``birge_ratio`` (sqrt(chi2 / dof)),
-    ``covariance_scaled`` (whether ``covariance`` and ``std`` were scaled by chi2 / dof, as when
-    p < 0.001), ``residuals`` (one list per window, in the order of ``windows``, in noise units:
+    ``covariance_scaled`` (whether ``covariance`` and ``std`` hold more than the noise: the windows'
+    scatter beyond it (first-moment), or chi2 / dof when p < 0.001 (the paper's methods)), ``residuals`` (one list per window, in the order of ``windows``, in noise units:
     one value for a turn, three for a static window), ``labels`` (the windows' names),
-    ``disagree`` (the windows that disagree most, when flagged), ``warnings`` (list of text).
+    ``disagree`` (the windows that disagree most, when flagged), ``warnings`` (list of text),
+    ``excess`` (the scatter beyond the noise the covariance carries: ``turn_reference_sd`` in
+    ``turn_reference_unit``, ``static_level_sd`` per axis in ``static_level_unit``, and ``groups``, each
+    group's noise-only ``chi2`` for its ``dof``; null for the paper's methods) and ``notes`` (list of text).
     """
 
     NAME = "fit"
     FIELDS = {"chi2": number(0), "dof": integer(0), "chi2_per_dof": number(0), "p_value": number(0, 1),
               "birge_ratio": number(0), "covariance_scaled": boolean, "residuals": _residuals,
-              "labels": texts, "disagree": numbers((-1,), 0), "warnings": texts}
+              "labels": texts, "disagree": numbers((-1,), 0), "warnings": texts, "notes": texts}
 
 
 class Observed(Section):

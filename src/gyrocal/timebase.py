@@ -33,6 +33,10 @@ _BLOCK = 64  # steps per block of the robust period estimate
 _ENVELOPE = 50  # samples each side over which the clock residual's lower envelope is taken, at least
 _ENVELOPE_S = 0.5  # [s] and at least this long: a late packet's burst must drain inside it
 _STRETCH = 1 << 16  # samples per pass over long logs: the temporaries stay in the cache
+#: A late delivery (a step over `_LATE_STEP` periods that lost nothing) is, with several samples per packet,
+#: longer than the packets' own step by this many periods and by `_LATE_HOLD` [s] (at 1 kHz a PC's scheduling jitter alone spans a few periods).
+_LATE_EXTRA = 2.0
+_LATE_HOLD = 0.01
 
 
 def nominal_period(t: np.ndarray) -> float:
@@ -101,6 +105,21 @@ class TimeBase:
         return 1.0 / (self.clock_period if self.regular_clock else self.period)
 
     @property
+    def counted(self) -> bool:
+        """Whether the time is a count of samples at a nominal rate rather than a clock's reading.
+
+        True without a time column (the rate was declared) and for stamps that step by exactly one
+        round period (a whole number of 0.1 Hz): a sample counter times the chip's nominal rate. A
+        chip's own oscillator runs off that rate by a fraction of a per cent or more, and every
+        angle integrated on such a time base carries that error. A PC's receive times (jitter), or
+        a logger's crystal (a period off round by its ppm), measure time.
+        """
+        if not self.has_time:
+            return True
+        rate = 1.0 / self.period
+        return not self.gaps and self.jitter <= 1e-6 * self.period and abs(rate * 10 - round(rate * 10)) <= 1e-6 * rate
+
+    @property
     def lost(self) -> int:
         """Samples missing in all gaps."""
         return sum(g.lost for g in self.gaps)
@@ -150,6 +169,8 @@ class TimeBase:
             f"time base: {self.sample_rate:.6g} Hz nominal (mean step of the sensor clock); "
             f"steps mean {self.mean_step * ms:.4g} ms, median {self.median_step * ms:.4g} ms, jitter {jitter}"
         ]
+        if self.counted:
+            lines.append("  every step is the same, a round period: a sample counter times the chip's nominal rate?")
         if self.bursty:
             on = ("the sensor's regular clock rebuilt from them" if self.regular_clock else "the stamps")
             lines.append(f"  steps are bursty (receive-time stamps?): angles are integrated on {on}, and the rate "
@@ -256,7 +277,6 @@ def analyse_time(t, *, has_time: bool = True) -> TimeBase:
             keep = np.ones(len(sample), dtype=bool)
             keep[np.isin(spread, [g.index - 1 for g in gaps])] = 0
             sample = sample[keep] if keep.any() else sample
-    late = _count_steps_over(t, _LATE_STEP * period) if longest > _LATE_STEP * period else 0
     return TimeBase(
         n=len(t),
         span=float(t[-1] - t[0]),
@@ -264,13 +284,28 @@ def analyse_time(t, *, has_time: bool = True) -> TimeBase:
         mean_step=float(t[-1] - t[0]) / (len(t) - 1),
         median_step=float(np.median(sample)),
         jitter=float(sample.std()) if len(sample) > 1 else 0.0,
-        delayed=late - sum(g.step > _LATE_STEP * period for g in gaps),
+        delayed=_late(t, longest, sample, period, gaps),
         gaps=tuple(gaps),
         has_time=has_time,
         regular_clock=clock is not None,
         clock_start=clock[0] if clock else float(t[0]),
         clock_period=clock[1] if clock else period,
     )
+
+
+def _late(t: np.ndarray, longest: float, sample: np.ndarray, period: float, gaps) -> int:
+    """Late deliveries: long steps that lost nothing, longer than the packets' own step by `_LATE_EXTRA` periods
+    and `_LATE_HOLD`.
+
+    With four samples per packet every fourth step is four periods long: that is the packet rhythm,
+    not a delivery held up. `sample` is an even spread of the steps (the packets' step is their
+    median above half a period).
+    """
+    packet = float(np.median(sample[sample > 0.5 * period])) if np.any(sample > 0.5 * period) else period
+    limit = max(_LATE_STEP * period, packet + max(_LATE_EXTRA * period, _LATE_HOLD))
+    if longest <= limit:
+        return 0
+    return _count_steps_over(t, limit) - sum(g.step > limit for g in gaps)
 
 
 def _fit_clock(t: np.ndarray, period: float, floor: np.ndarray, k: np.ndarray) -> tuple[float, float] | None:

@@ -8,11 +8,14 @@
   the longest plateau (all plateaus run at the declared speed), by
   :func:`gyrocal.longrun.find_lines`.
 * With ``long_run=True`` the variance of each window mean holds for correlated noise and what
-  is left of the ripple: one long-run (Newey-West) variance per axis is pooled over the
-  plateaus' residuals, and one over the static windows (sensor noise at standstill is one
-  process; a variance estimated window by window would scatter, and its inverse read the
-  windows as disagreeing more than they do). A whole turn (angle reference) keeps white noise
-  pooled by the estimator, since its integral is exact whatever the speed did.
+  is left of the ripple. The static windows pool one long-run (Newey-West) variance per axis
+  (sensor noise at standstill is one process; a variance estimated window by window would
+  scatter, and its inverse read the windows as disagreeing more than they do). A whole turn
+  (angle reference) integrates the same sensor noise, so its mean takes that long-run variance
+  too: a chip's internal low-pass filter makes successive samples alike, and the white noise of
+  first differences then understates a turn's angle noise (twenty times at 1 kHz behind a 41 Hz
+  filter). The plateaus' residuals hold the sensor noise and the servo's bounded angle error
+  (vibration), which :func:`gyrocal.longrun.span_variance` separates.
 
 The plateau and static statistics work on block means at about 200 Hz: the same level, the
 same variance of the mean, a fifth of the work at 1 kHz.
@@ -24,7 +27,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .longrun import block_means, find_lines, fit_levels, newey_west_var
+from .longrun import block_means, find_lines, fit_levels, newey_west_var, span_variance
 from .observations import Observation, observe_many
 from .recording import Recording
 from .windows import Window
@@ -95,6 +98,7 @@ def _window_stats(rec: Recording, windows: Sequence[Window], reference: str, tim
     span = {i: (-(-w.start // d), w.stop // d) for i, w in enumerate(windows)}
     blocks = {i: gyro[a:b] for i, (a, b) in span.items() if b - a >= 4}
     plateaus = [i for i in blocks if windows[i].kind == "rotation" and reference == "speed"]
+    turns = [i for i, w in enumerate(windows) if w.kind == "rotation" and reference == "angle"]
     statics = [i for i in blocks if windows[i].kind == "static"]
     out: dict[int, dict] = {}
     if plateaus:
@@ -103,6 +107,8 @@ def _window_stats(rec: Recording, windows: Sequence[Window], reference: str, tim
         lrv = _pooled_lrv([lambda b=blocks[i]: b - b.mean(axis=0) for i in statics], [len(blocks[i]) for i in statics])
         for i in statics:
             out[i] = {"mean_var": lrv / len(blocks[i])}
+        for i in turns:  # the turn's mean integrates the same sensor noise over its length
+            out[i] = {"mean_var": lrv * d / len(windows[i])}
     return out
 
 
@@ -124,7 +130,7 @@ def _plateau_stats(blocks: dict, span: dict, plateaus: list[int], times: np.ndar
     fits = dict(zip(plateaus, fit_levels([blocks[i] for i in plateaus], ts, lines)))
     out: dict[int, dict] = {i: {"level": fits[i][0]} for i in plateaus} if ripple else {}
     if long_run:
-        lrv = _pooled_lrv([fits[i][2] for i in plateaus], [len(blocks[i]) for i in plateaus])
+        a, b = span_variance([fits[i][2] for i in plateaus])
         for i in plateaus:
-            out.setdefault(i, {})["mean_var"] = lrv * fits[i][1]
+            out.setdefault(i, {})["mean_var"] = b * fits[i][1] + a * fits[i][1] ** 2
     return out

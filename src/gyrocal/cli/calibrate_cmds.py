@@ -103,7 +103,8 @@ def _windows_from_file(path: Optional[Path], rec):
         return None
     from ..io import read_windows
 
-    return read_windows(path, sample_rate=rec.sample_rate, t0=float(rec.t[0]), n_samples=len(rec))
+    return read_windows(path, sample_rate=rec.sample_rate, t0=float(rec.t[0]), n_samples=len(rec),
+                        t=rec.t if rec.has_time else None)
 
 
 def _example_paths() -> tuple[Path, Path]:
@@ -150,12 +151,10 @@ def _print_calibration(run, truth=None) -> None:
     import numpy as np
 
     from ..segmentation import describe_found
-    from ..units import from_rad_s
 
     cal = run.calibration
     table, canon = _params_table(run, truth)
-    ref = (f"speed {from_rad_s(run.reference_value, cal.output_units):g} {cal.output_units}"
-           if run.reference == "speed" else f"angle {math.degrees(run.reference_value):g} deg per turn")
+    ref = run.reference_text(cal.output_units)
     console.print(f"{cal.method}, {ref}: g = diag(k) (m + b), the servo method of Wang et al., eq. 1",
                   highlight=False, soft_wrap=True)
     console.print(table)

@@ -85,7 +85,8 @@ def imu(
     if windows is not None:
         from ..io import read_windows
 
-        win = read_windows(windows, sample_rate=rec.sample_rate, t0=float(rec.t[0]), n_samples=len(rec))
+        win = read_windows(windows, sample_rate=rec.sample_rate, t0=float(rec.t[0]), n_samples=len(rec),
+                           t=rec.t if rec.has_time else None)
     run = calibrate_recording(rec, windows=win, gravity=gravity, accel_model=accel_model, gyro_model=gyro_model,
                               g_sensitivity=g_sensitivity, min_static=min_static, output_units=output_units,
                               accel_output_units=accel_output_units)

@@ -31,7 +31,7 @@ def _direction_jacobian(prob: GyroProblem, a, b, g, directions, directions_std) 
     out = np.zeros((2 * n_pairs, n, 3))
     if not n_pairs:
         return out
-    from . import quaternion as quat
+    from .. import quaternion as quat
 
     rot = quat.attitude_matrices(prob.t_cat, prob.omega_params(a, b, g), prob.bounds)
     e1, e2 = tangent_basis(directions[prob.pairs[:, 1]])

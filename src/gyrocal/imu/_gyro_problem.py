@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import quaternion as quat
+from .. import quaternion as quat
 
 __all__ = ["EARTH_RATE", "GyroProblem", "Turn", "build_problem"]
 

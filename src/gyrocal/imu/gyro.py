@@ -175,7 +175,7 @@ def _checks(prob: GyroProblem, p, model, with_g, statics, accel: AccelFit, means
 
 def quat_angles(t, omega, bounds) -> np.ndarray:
     """Rotation angle of each interval [rad]."""
-    from . import quaternion as quat
+    from .. import quaternion as quat
 
     q = quat.attitude_change(t, omega, bounds)
     return 2 * np.arccos(np.clip(np.abs(q[:, 0]), 0, 1))

@@ -16,10 +16,10 @@ from itertools import product
 
 import numpy as np
 
+from .. import quaternion as quat
 from .._validation import positive
 from ..errors import DegenerateDesignError, InputError
 from . import _fit
-from . import quaternion as quat
 from ._gyro_cov import noise_model, whitener
 from ._gyro_problem import build_problem
 from ._gyro_solve import jacobian, residuals

@@ -18,8 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import quaternion as quat
 from .._validation import finite_array
-from . import quaternion as quat
 
 __all__ = [
     "MIN_JERK_PEAK",

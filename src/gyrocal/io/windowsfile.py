@@ -11,7 +11,10 @@ Three layouts are read:
   in sample indices, or ``t_start, t_stop`` (or ``"unit": "s"``) in seconds.
 * a CSV table with the same columns, one window per row.
 
-Times become indices as ``round((t - t0) * sample_rate)``; stop stays exclusive.
+Times become indices through the recording's own time column when it is given (`t`): a
+window ``[t_start, t_stop]`` holds the samples stamped inside it, so packet gaps and a sample
+rate off its nominal value move nothing. Without a time column they become
+``round((t - t0) * sample_rate)``. Stop stays exclusive.
 """
 
 from __future__ import annotations
@@ -23,6 +26,8 @@ import math
 import os
 from pathlib import Path
 
+import numpy as np
+
 from .._validation import positive
 from ..errors import FileFormatError, InputError
 from ..windows import Window
@@ -32,7 +37,8 @@ __all__ = ["read_windows"]
 _KINDS = {"rotation": "rotation", "rot": "rotation", "turn": "rotation", "static": "static", "still": "static", "rest": "static"}
 
 
-def read_windows(path: str | os.PathLike, *, sample_rate: float, t0: float = 0.0, n_samples: int | None = None) -> list[Window]:
+def read_windows(path: str | os.PathLike, *, sample_rate: float, t0: float = 0.0, n_samples: int | None = None,
+                 t=None) -> list[Window]:
     """Read a windows file into windows sorted by start.
 
     Parameters
@@ -45,6 +51,9 @@ def read_windows(path: str | os.PathLike, *, sample_rate: float, t0: float = 0.0
         Time of sample 0 [s] (``Recording.t[0]`` for a recording with a time column).
     n_samples : int, optional
         Length of the recording; every window must end inside it.
+    t : array_like, shape (n_samples,), optional
+        The recording's sample times [s] (its time column). Times in the file are then looked up
+        in it, so a gap in the log (samples never delivered) does not shift the windows after it.
 
     Raises
     ------
@@ -62,7 +71,8 @@ def read_windows(path: str | os.PathLike, *, sample_rate: float, t0: float = 0.0
         records = _csv_records(text, path.name)
     if not records:
         raise FileFormatError(f"{path.name}: holds no windows")
-    windows = [_window(rec, i, fs, float(t0), path.name) for i, rec in enumerate(records)]
+    clock = _Clock(fs, float(t0), None if t is None else np.asarray(t, dtype=float))
+    windows = [_window(rec, i, clock, path.name) for i, rec in enumerate(records)]
     if n_samples is not None:
         for w in windows:
             if w.stop > n_samples:
@@ -119,25 +129,42 @@ def _number(rec: dict, key: str, where: str) -> float:
     return value
 
 
-def _index(rec: dict, keys: tuple[str, ...], where: str, fs: float, t0: float) -> int:
+class _Clock:
+    """Seconds to sample indices: through the time column when there is one, else the nominal rate."""
+
+    def __init__(self, fs: float, t0: float, t: np.ndarray | None):
+        self.fs, self.t0, self.t = fs, t0, t
+
+    def index(self, value: float) -> int:
+        """The first sample stamped at or after `value` (within half a period, as rounding would)."""
+        t = self.t
+        if t is None or len(t) < 2:
+            return round((value - self.t0) * self.fs)
+        half = 0.5 / self.fs
+        if value > t[-1] + 1.5 / self.fs:  # past the log: an index past its end, for the caller's range check
+            return len(t) + max(1, round((value - t[-1]) * self.fs))
+        return int(np.searchsorted(t, value - half))
+
+
+def _index(rec: dict, keys: tuple[str, ...], where: str, clock: _Clock) -> int:
     seconds = str(rec.get("unit", "")).strip().lower() in ("s", "sec", "seconds")
     for key in keys:
         if key in rec:
             value = _number(rec, key, where)
             if key.startswith("t_") or seconds:
-                return round((value - t0) * fs)
+                return clock.index(value)
             if value != int(value):
                 raise FileFormatError(f"{where}: field '{key}' is a sample index and must be whole, got {rec[key]!r}", key)
             return int(value)
     raise FileFormatError(f"{where}: needs one of the fields {', '.join(keys)}", keys[0])
 
 
-def _window(rec: dict, i: int, fs: float, t0: float, source: str) -> Window:
+def _window(rec: dict, i: int, clock: _Clock, source: str) -> Window:
     rec = {str(k).strip().lower(): v for k, v in rec.items()}
     label = str(rec.get("label") or rec.get("name") or "")
     where = f"{source}: window {label or '#' + str(i + 1)}"
-    start = _index(rec, ("start", "t_start"), where, fs, t0)
-    stop = _index(rec, ("stop", "end", "t_stop", "t_end"), where, fs, t0)
+    start = _index(rec, ("start", "t_start"), where, clock)
+    stop = _index(rec, ("stop", "end", "t_stop", "t_end"), where, clock)
     kind = _KINDS.get(str(rec.get("kind", "")).strip().lower())
     if kind is None:
         raise FileFormatError(f"{where}: field 'kind' is {rec.get('kind')!r}; use 'rotation' or 'static'", "kind")

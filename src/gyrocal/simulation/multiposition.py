@@ -19,10 +19,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import quaternion as quat
 from .._validation import finite_array, positive
 from ..errors import InputError
 from ..imu import poses as _poses
-from ..imu import quaternion as quat
 from ..imu.gyro import EARTH_RATE
 from .gyro import VirtualGyro
 

@@ -1,0 +1,43 @@
+"""The self-checks of a fit: goodness of fit, scatter beyond the noise carried into the covariance, plausibility.
+
+:func:`check_fit` runs after the estimator: it tests the windows against their noise (all rows,
+and the turns and the static levels as groups, :mod:`gyrocal.quality`), widens the first-moment
+covariance by each group's scatter beyond the noise (:mod:`gyrocal.excess`; the paper's methods
+are scaled by the Birge ratio instead), and judges the scale factors (:mod:`gyrocal.plausibility`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+
+from .estimators import FitResult, window_residuals
+from .excess import widen
+from .observations import ObservationSet
+from .plausibility import Context, check_plausibility
+from .quality import GoodnessOfFit, assess_fit
+
+__all__ = ["check_fit"]
+
+
+def check_fit(fit: FitResult, obs: ObservationSet, estimator, labels: Sequence[str], *, reference: str,
+              ctx: Context, input_scale: float) -> tuple[FitResult, ObservationSet, GoodnessOfFit, list[str], list[str]]:
+    """Check `fit` of `obs`; returns the fit to report (widened where the windows scatter), its windows,
+    the goodness of fit, and the warnings and notes for people.
+
+    `input_scale` is internal units per input unit (static levels are reported in the input unit).
+    """
+    first_moment = fit.method == "first-moment"
+    what = "the turns and static windows" if first_moment else "the turns"
+    residuals = window_residuals(fit, obs)  # in noise units, before any widening
+    if first_moment:
+        fit, obs, excess = widen(fit, obs, estimator, reference)
+        quality = assess_fit(residuals, labels, len(fit.model.params), what=what, excess=excess,
+                             widened=excess.describe(input_scale, ctx.units),
+                             excess_document=excess.to_document(input_scale, ctx.units))
+    else:
+        quality = assess_fit(residuals, labels, len(fit.model.params), what=what)
+        if quality.covariance_scaled and fit.covariance is not None:
+            fit = dataclasses.replace(fit, covariance=fit.covariance * quality.birge_ratio**2)
+    plausible, notes = check_plausibility(fit.model.k, ctx)
+    return fit, obs, quality, list(quality.warnings) + plausible, list(quality.notes) + notes
