@@ -19,9 +19,9 @@ import numpy as np
 
 from gyrocal._validation import finite_array, positive
 from gyrocal.errors import InputError
-from gyrocal.longrun import _design, block_means, find_lines
+from gyrocal.longrun import _design, block_means, find_lines, span_variance
 from gyrocal.observations import Observation
-from gyrocal.timebase import TimeBase, _block_size, _fit_clock, nominal_period
+from gyrocal.timebase import _LATE_EXTRA, _LATE_HOLD, TimeBase, _block_size, _fit_clock, nominal_period
 from gyrocal.timegaps import CANDIDATE_STEP as _CANDIDATE_STEP
 from gyrocal.timegaps import LATE_STEP as _LATE_STEP
 from gyrocal.timegaps import Gap
@@ -80,7 +80,7 @@ def observe_windows(rec, windows, reference, speed, *, long_run=True, ripple=Tru
         elif reference == "speed":
             out.append(observe(samples, rec.sample_rate, "speed", speed=speed, t=t, **extra))
         else:
-            out.append(observe(samples, rec.sample_rate, "angle", angle=w.angle, t=t))
+            out.append(observe(samples, rec.sample_rate, "angle", angle=w.angle, t=t, mean_var=extra.get("mean_var")))
     return tuple(out)
 
 
@@ -130,6 +130,7 @@ def window_stats(rec, windows, reference, times, *, long_run, ripple):
     span = {i: (-(-w.start // d), w.stop // d) for i, w in enumerate(windows)}
     blocks = {i: gyro[a:b] for i, (a, b) in span.items() if b - a >= 4}
     plateaus = [i for i in blocks if windows[i].kind == "rotation" and reference == "speed"]
+    turns = [i for i, w in enumerate(windows) if w.kind == "rotation" and reference == "angle"]
     statics = [i for i in blocks if windows[i].kind == "static"]
     lines = []
     if ripple and plateaus:
@@ -143,13 +144,15 @@ def window_stats(rec, windows, reference, times, *, long_run, ripple):
         if ripple:
             out[i] = {"level": level}
     if long_run and plateaus:
-        lrv = _pooled_lrv([resid[i] for i in plateaus])
+        a, b = span_variance([resid[i] for i in plateaus])
         for i in plateaus:
-            out.setdefault(i, {})["mean_var"] = lrv * factor[i]
+            out.setdefault(i, {})["mean_var"] = b * factor[i] + a * factor[i] ** 2
     if long_run and statics:
         lrv = _pooled_lrv([blocks[i] - blocks[i].mean(axis=0) for i in statics])
         for i in statics:
             out[i] = {"mean_var": lrv / len(blocks[i])}
+        for i in turns:
+            out[i] = {"mean_var": lrv * d / len(windows[i])}
     return out
 
 
@@ -246,13 +249,20 @@ def analyse_time(t, *, has_time: bool = True) -> TimeBase:
         mean_step=float(t[-1] - t[0]) / (len(t) - 1),
         median_step=float(np.median(sample)),
         jitter=float(sample.std()) if len(sample) > 1 else 0.0,
-        delayed=int(np.count_nonzero(step > _LATE_STEP * period)) - sum(g.step > _LATE_STEP * period for g in gaps),
+        delayed=_late(step, sample, period, gaps),
         gaps=tuple(gaps),
         has_time=has_time,
         regular_clock=clock is not None,
         clock_start=clock[0] if clock else float(t[0]),
         clock_period=clock[1] if clock else period,
     )
+
+
+def _late(step, sample, period, gaps) -> int:
+    """Long steps beyond the packets' own step that lost nothing, counted over the whole step array."""
+    packet = float(np.median(sample[sample > 0.5 * period])) if np.any(sample > 0.5 * period) else period
+    limit = max(_LATE_STEP * period, packet + max(_LATE_EXTRA * period, _LATE_HOLD))
+    return int(np.count_nonzero(step > limit)) - sum(g.step > limit for g in gaps)
 
 
 # -- the calibration's other pieces as they were --

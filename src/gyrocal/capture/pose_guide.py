@@ -26,8 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import quaternion as quat
 from ..errors import InputError
-from ..imu import quaternion as quat
 from ..imu.planning import DETECTOR_WINDOW
 from ..imu.poses import DISTINCT_DEG, UP, coverage, pose_sequence
 from ..imu.statics import detect_statics

@@ -15,8 +15,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from .. import quaternion as quat
 from .._validation import positive
-from ..imu import quaternion as quat
 from ..imu.poses import UP
 from ..models import ScaleBias
 from ..simulation import VirtualGyro
