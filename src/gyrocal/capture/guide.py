@@ -28,7 +28,7 @@ from ..recording import Recording
 from ..segmentation import segment
 from ..windows import Window
 
-__all__ = ["GUIDES", "Guide", "GuideEvent", "Step"]
+__all__ = ["GUIDES", "Guide", "GuideEvent", "Step", "SteppedJudge"]
 
 #: Scale factors a guided turn may imply: its measured size within 25 % of the asked one.
 _GUIDE_K_RANGE = (0.8, 1 / 0.75)
@@ -78,7 +78,25 @@ class GuideEvent:
     text: str
 
 
-class Guide:
+class SteppedJudge:
+    """Judging at fixed points of the data, so the outcome does not depend on how samples arrived in chunks.
+
+    Subclasses keep ``_checked`` (samples judged so far), ``complete``, and ``_judge(rec, offset, n)``.
+    """
+
+    _checked: int
+
+    def _step_through(self, rec: Recording, offset: int, every: float) -> list[GuideEvent]:
+        """Judge at every `every` seconds of samples up to the end of `rec` (samples ``offset ..``)."""
+        stride = max(1, round(every * rec.sample_rate))
+        events: list[GuideEvent] = []
+        while not self.complete and self._checked + stride <= offset + len(rec):
+            self._checked += stride
+            events += self._judge(rec, offset, self._checked)
+        return events
+
+
+class Guide(SteppedJudge):
     """Walk a person through a session (see the module notes).
 
     Parameters
@@ -141,16 +159,9 @@ class Guide:
         """Judge the current step on the recording so far (rad/s, or counts with a sensitivity): `rec` holds
         samples ``offset ..`` of the capture (absolute indices), from :attr:`keep_from` on or earlier.
 
-        Steps are judged at fixed points of the data (every `every` seconds of samples), so the
-        outcome does not depend on how the samples arrived in chunks.
+        Steps are judged every `every` seconds of samples (:class:`SteppedJudge`).
         """
-        fs = rec.sample_rate
-        stride = max(1, round(every * fs))
-        events: list[GuideEvent] = []
-        while not self.complete and self._checked + stride <= offset + len(rec):
-            self._checked += stride
-            events += self._judge(rec, offset, self._checked)
-        return events
+        return self._step_through(rec, offset, every)
 
     def _judge(self, rec: Recording, offset: int, n: int) -> list[GuideEvent]:
         fs = rec.sample_rate

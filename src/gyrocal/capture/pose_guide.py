@@ -33,7 +33,7 @@ from ..imu.poses import DISTINCT_DEG, UP, coverage, pose_sequence
 from ..imu.statics import detect_statics
 from ..recording import Recording
 from ..windows import Window
-from .guide import GuideEvent
+from .guide import GuideEvent, SteppedJudge
 
 __all__ = ["CANDIDATES", "HOLD_S", "MIN_POSES", "MIN_SPREAD", "PoseGuide", "describe", "guided_directions",
            "next_target", "plan_directions"]
@@ -140,7 +140,7 @@ class _Pose:
     target: np.ndarray
 
 
-class PoseGuide:
+class PoseGuide(SteppedJudge):
     """Walk a person through a multi-position hand session (see the module notes).
 
     Parameters
@@ -222,13 +222,7 @@ class PoseGuide:
             raise InputError("the multi-position guide needs the accelerometer: send 6-axis frames (the example "
                              "firmware with an accelerometer sensitivity) or text lines with ax, ay, az columns",
                              param="guide")
-        fs = rec.sample_rate
-        stride = max(1, round(self.every * fs))
-        events: list[GuideEvent] = []
-        while not self.complete and self._checked + stride <= offset + len(rec):
-            self._checked += stride
-            events += self._judge(rec, offset, self._checked)
-        return events
+        return self._step_through(rec, offset, self.every)
 
     def _judge(self, rec: Recording, offset: int, n: int) -> list[GuideEvent]:
         fs = rec.sample_rate
