@@ -206,3 +206,27 @@ def test_reference_reading_errors_name_the_ref_flags(bench, tmp_path):
     folder, _ = bench
     line = refused(*_verify_args(folder, "--ref-units", "rad/s"))
     assert "use --ref-units deg/s (or --ref-no-unit-check)" in line
+
+
+def test_readme_shows_what_its_verify_commands_print(tmp_path):
+    """README's 'Proof on the bench' runs two commands and shows their Table V and alignment. Reference: the
+    summary.md those same commands write now (the example and its bootstrap are seeded), so a change that
+    moves a figure must re-measure README too."""
+    from pathlib import Path
+
+    readme = (Path(__file__).resolve().parent.parent / "README.md").read_text(encoding="utf-8")
+    section = readme[readme.index("## Proof on the bench"):]
+    section = section[:section.index("\n## ", 1)]
+    assert invoke("calibrate", "--example", "-o", tmp_path / "cal.json")[0] == 0
+    code, _, err = invoke("verify", tmp_path / "cal.json", "--example", "-o", tmp_path / "verify", "--no-figures")
+    assert code == 0, err
+    summary = (tmp_path / "verify" / "summary.md").read_text(encoding="utf-8")
+    rows = [line for line in summary.splitlines() if line[:4] in ("| x ", "| y ", "| z ")][:3]  # Table V rows
+    assert len(rows) == 3
+    for row in rows:
+        assert row in section, f"README's Table V lacks {row!r}"
+    for label, words in (("time offset", "offset {} s"), ("clock drift", "drift {} ppm"),
+                         ("mounting rotation angle", "mounting {}°")):
+        line = next(ln for ln in summary.splitlines() if ln.startswith(f"| {label}"))
+        value = line.split("|")[2].strip().rsplit(" ", 1)[0]  # '-1.82951 ± 0.00073'
+        assert words.format(value.replace("-", "−")) in section, f"README lacks {label} {value}"
