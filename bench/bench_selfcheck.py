@@ -98,8 +98,8 @@ def main() -> None:
 
         windows = ObservationSet.from_observations(run.observations)  # built by the calibration either way
         own = min(cpu_time(lambda run=run, w=windows: _check_steps(rec, run, w)) for _ in range(args.repeat))
-        print(f"  the self-check steps on their own (time base, gap screening, fit quality, plausibility, the file's "
-              f"sections): {own:.4f} s = {100 * own / best['estimate']:.1f} % of the calibration without them")
+        print(f"  the self-check steps on their own (time base, gap screening, wandering axes, fit quality with the "
+              f"extra variances and their refits, plausibility, the file's sections): {own:.4f} s = {100 * own / best['estimate']:.1f} % of the calibration without them")
         pair = _pair(rec, ref, args.repeat)
         print(f"  the two alone, alternating without the naive code between them (its whole-log arrays move the "
               f"allocator's pages): without {pair['estimate']:.3f} s, with {pair['checked']:.3f} s: the self-checks "
@@ -113,21 +113,29 @@ def main() -> None:
 
 
 def _check_steps(rec, run, windows) -> None:
-    """The steps only the self-checks take, as ``calibrate`` takes them (on the `windows` `run` used)."""
-    from gyrocal.estimators import window_residuals
+    """The steps only the self-checks take, as ``calibrate`` takes them (on the `windows` `run` used): time
+    base, gap screening, the wandering-axis pass (angles), goodness of fit with the groups' extra variances and
+    their refits, plausibility, the file's sections."""
+    from gyrocal.estimators import make_estimator
+    from gyrocal.fit_checks import check_fit
     from gyrocal.pipeline import _observed
-    from gyrocal.plausibility import Context, check_plausibility
-    from gyrocal.quality import assess_fit
+    from gyrocal.plausibility import Context
     from gyrocal.screening import screen_gaps
     from gyrocal.sections import FitQuality, Observed
+    from gyrocal.turn_angle import follow_wander
 
     tb = rec.time_base()
     screen_gaps(run.segmentation, rec, tb, run.reference, tb.clock_times() if tb.gaps else None)
+    estimator = make_estimator("first-moment")
+    fit = estimator.fit(windows)  # the fit the checks start from (the run's own is already widened)
+    if run.reference == "angle":
+        follow_wander(rec, rec.t, run.segmentation.windows, run.observations, windows,
+                      fit, estimator)
     labels = [w.get("label") or w["kind"] for w in run.calibration.windows]
-    quality = assess_fit(window_residuals(run.fit, windows), labels, 6)
-    check_plausibility(run.fit.model.k, Context(units="rad/s", counts_scale=False, reference=run.reference,
-                                                declared=run.reference_value, sample_rate=rec.sample_rate,
-                                                has_time=rec.has_time, sensitivity=None))
+    ctx = Context(units="rad/s", counts_scale=False, reference=run.reference, declared=run.reference_value,
+                  sample_rate=rec.sample_rate, has_time=rec.has_time, sensitivity=None, counted=tb.counted)
+    fit, _, quality, _, _ = check_fit(fit, windows, estimator, labels, reference=run.reference, ctx=ctx,
+                                      input_scale=1.0)
     FitQuality(quality.to_document())
     Observed(_observed(rec, tb, run.fit.noise_std, 1.0, "rad/s"))
 
