@@ -401,3 +401,27 @@ def test_a_closed_stdout_does_not_cost_the_outputs(tmp_path):
     _, err = proc.communicate(timeout=120)
     assert b"Traceback" not in err
     assert load_calibration(out).method == "first-moment" and plot.stat().st_size > 0
+
+
+def test_declared_reference_accuracy_flags(tmp_path):
+    """--speed-sd / --angle-sd: the accuracy enters the 1-sigma and the file says so; mixed with the other
+    reference, negative, or with the paper's methods, one line and exit 2. Reference: first-order propagation,
+    a plateau's rate known to 0.1 deg/s in 60 adds (0.1 / 60)^2 / 2 to each k's relative variance (two plateaus
+    per axis)."""
+    import json
+
+    plain, declared = tmp_path / "plain.json", tmp_path / "declared.json"
+    assert invoke("calibrate", "--example", "-o", plain)[0] == 0
+    code, out, err = invoke("calibrate", "--example", "--speed-sd", "0.1", "-o", declared)
+    assert code == 0, err
+    assert "declared accuracy of every turn's speed, 0.1 deg/s" in out + err
+    a, b = json.loads(plain.read_text()), json.loads(declared.read_text())
+    k = np.array(b["parameters"]["scale_bias"]["k"])
+    sd_a = np.array([a["std"][f"k{c}"] for c in "xyz"])
+    sd_b = np.array([b["std"][f"k{c}"] for c in "xyz"])
+    assert np.all(sd_b**2 >= sd_a**2 + 0.9 * k**2 * (0.1 / 60) ** 2 / 2)
+    assert any("declared accuracy" in n for n in b["fit"]["notes"])
+    assert "with --speed give --speed-sd" in refused("calibrate", "--example", "--angle-sd", "0.05")
+    assert "--speed-sd must be a number >= 0" in refused("calibrate", "--example", "--speed-sd", "-1")
+    assert "not --method lm" in refused("calibrate", "--example", "--speed-sd", "0.1", "--method", "lm")
+    assert "for turn angles give --angle-sd" in refused("calibrate", "--example", "--angle", "360", "--speed-sd", "1")

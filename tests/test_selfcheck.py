@@ -128,6 +128,26 @@ def test_a_clean_session_passes_its_own_check():
     assert kstest(p, "uniform").pvalue > 1e-3 and scaled <= 3
 
 
+def test_a_declared_reference_accuracy_enters_the_scale_factors_variance(rng):
+    """Reference: first-order propagation. Each axis's k rests on its two turns (+ and -), and a turn's rate is
+    its angle over its time, so an angle sd of s on every turn of angle A adds ``k^2 (s / A)^2 / 2`` to var(k),
+    on top of the noise's variance; the biases lose what the turns told of them and rest on the static windows.
+    (Without the checks,
+    which would also carry a scatter the turns happen to show, on top of the declared sd.)"""
+    rec, _ = simulate_servo(GYRO, ServoProtocol(misalignment_deg=3), rng=rng)
+    plain = calibrate(rec, angle=2 * math.pi, checks=False)
+    declared = calibrate(rec, angle=2 * math.pi, reference_sd=math.radians(1.0), checks=False)
+    expected = np.sqrt(plain.fit.std[:3] ** 2 + declared.fit.model.k**2 * (1.0 / 360.0) ** 2 / 2)
+    np.testing.assert_allclose(declared.fit.std[:3], expected, rtol=0.03)
+    assert np.all(declared.fit.std[3:] >= plain.fit.std[3:])
+    checked = calibrate(rec, angle=2 * math.pi, reference_sd=math.radians(1.0))
+    assert any("declared accuracy of every turn's angle, 1 deg" in n for n in checked.notes)
+    with pytest.raises(InputError, match="applies to method 'first-moment' only"):
+        calibrate(rec, angle=2 * math.pi, method="lm", reference_sd=0.01)
+    with pytest.raises(InputError, match=">= 0"):
+        calibrate(rec, angle=2 * math.pi, reference_sd=-1.0)
+
+
 def test_no_degrees_of_freedom_is_said(rng):
     rec, _ = simulate_servo(GYRO, ServoProtocol(), rng=rng)
     run = calibrate(rec, speed=math.radians(60), method="algorithm1")

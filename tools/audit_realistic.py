@@ -7,7 +7,7 @@ misalignment and non-orthogonality, hand tilts with a wandering axis). Every run
 command line in-process (``tests/cli_runner.py``) and is scored against the generator's truth:
 ``z = (k - k_true) / reported 1-sigma``; a run is *flagged* when it printed a ``warning:`` line.
 
-    python tools/audit_realistic.py --scenario robot --seeds 10
+    python tools/audit_realistic.py --scenario robot --seeds 12 [--angle-sd 0.05]
     python tools/audit_realistic.py --scenario all --seeds 4
 
 To measure the code before a change, put its source first: ``PYTHONPATH=/path/to/old/src python tools/...``.
@@ -70,6 +70,7 @@ def summary(z: list, flagged: list, label: str) -> str:
 
 GAPS = True  # packet gaps in the robot logs (--no-gaps: none)
 FIRST = 0  # first robot seed (--first-seed)
+ANGLE_SD = None  # the robot's angle accuracy declared to gyrocal [deg] (--angle-sd)
 
 
 def robot(seeds: int) -> None:
@@ -82,7 +83,8 @@ def robot(seeds: int) -> None:
                 rng = np.random.default_rng(1000 * seed + 10 * g + int(v))
                 log = R.record(R.robot_plan(v, rng), gyro, seed=int(rng.integers(1 << 30)), unit_seed=100 * seed + g,
                                gaps=((17, 17) if seed % 2 else (16,)) if GAPS else ())
-                res = calibrate(log, "--units", "deg/s", windows=log.windows(rng=rng, sync_sd=0.02))
+                declared = () if ANGLE_SD is None else ("--angle-sd", str(ANGLE_SD))
+                res = calibrate(log, "--units", "deg/s", *declared, windows=log.windows(rng=rng, sync_sd=0.02))
                 if res["code"]:
                     print(f"  seed {seed} gyro {g} {v:g} deg/s: exit {res['code']}: {res['error']}")
                     continue
@@ -284,9 +286,10 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, default=4)
     parser.add_argument("--no-gaps", action="store_true", help="robot logs without packet gaps")
     parser.add_argument("--first-seed", type=int, default=0, help="robot: first seed")
+    parser.add_argument("--angle-sd", type=float, help="robot: declare its angle accuracy [deg] (the generator's is 0.05)")
     args = parser.parse_args()
-    global GAPS, FIRST
-    GAPS, FIRST = not args.no_gaps, args.first_seed
+    global GAPS, FIRST, ANGLE_SD
+    GAPS, FIRST, ANGLE_SD = not args.no_gaps, args.first_seed, args.angle_sd
     import gyrocal
 
     print(f"gyrocal from {Path(gyrocal.__file__).parent}")

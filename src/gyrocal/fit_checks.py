@@ -9,6 +9,7 @@ are scaled by the Birge ratio instead), and judges the scale factors (:mod:`gyro
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Sequence
 
 from .estimators import FitResult, window_residuals
@@ -17,7 +18,7 @@ from .observations import ObservationSet
 from .plausibility import Context, check_plausibility
 from .quality import GoodnessOfFit, assess_fit
 
-__all__ = ["check_fit"]
+__all__ = ["check_fit", "single_turn_warnings"]
 
 
 def check_fit(fit: FitResult, obs: ObservationSet, estimator, labels: Sequence[str], *, reference: str,
@@ -41,3 +42,17 @@ def check_fit(fit: FitResult, obs: ObservationSet, estimator, labels: Sequence[s
             fit = dataclasses.replace(fit, covariance=fit.covariance * quality.birge_ratio**2)
     plausible, notes = check_plausibility(fit.model.k, ctx)
     return fit, obs, quality, list(quality.warnings) + plausible, list(quality.notes) + notes
+
+
+def single_turn_warnings(axes: Sequence[str], reference: str, declared: float) -> list[str]:
+    """A warning when some scale factor rests on one turn (`axes`: the turns' axes): its residual is zero,
+    nothing checks it."""
+    alone = [a for a in "xyz" if list(axes).count(a) == 1]
+    if not alone:
+        return []
+    deg = math.degrees(declared)
+    what = (f"their declared angle (1 deg in {deg:g} is {1 / deg:.2g} in k)" if reference == "angle"
+            else "their declared speed")
+    return [f"the scale factor{'s' if len(alone) > 1 else ''} of {', '.join(alone)} rest{'' if len(alone) > 1 else 's'} "
+            f"on one turn each: nothing in the data checks {what}; turn both ways or repeat the turns so that the "
+            "fit can check itself"]

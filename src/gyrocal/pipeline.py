@@ -25,13 +25,13 @@ import numpy as np
 from .calibration import Calibration
 from .errors import InputError
 from .estimators import FitResult, make_estimator
-from .fit_checks import check_fit
+from .fit_checks import check_fit, single_turn_warnings
 from .observations import Observation, ObservationSet
 from .observed import quiet_noise
 from .plausibility import Context
 from .quality import GoodnessOfFit
 from .recording import Recording
-from .screening import require_constant_rate, screen_gaps
+from .screening import reference_variances, require_constant_rate, screen_gaps
 from .segmentation import Segmentation, segment, standstill_level
 from .timebase import TimeBase
 from .turn_angle import follow_wander
@@ -225,6 +225,7 @@ def calibrate(
     output_units: str | None = None,
     checks: bool = True,
     long_run: bool = True,
+    reference_sd: float | None = None,
 ) -> CalibrationRun:
     """Calibrate a gyro from one recording of a servo, gimbal, robot or hand session.
 
@@ -259,6 +260,9 @@ def calibrate(
         of the data (correlated noise, what ripple is left), not sigma / sqrt(n).
         ``checks=False, long_run=False`` is the plain estimate on the stamps as they are, with a
         white-noise covariance (benchmarks and tests compare them).
+    reference_sd : float, optional
+        First-moment only: the accuracy (1-sigma) of each turn's reference, [rad] or [rad/s] (a robot's
+        specification), carried into the 1-sigma; an error the turns about one axis share shows in no residual.
 
     Raises
     ------
@@ -275,8 +279,9 @@ def calibrate(
     value = abs(float(speed if speed is not None else angle))
     if not (math.isfinite(value) and value > 0):
         raise InputError(f"{reference} must be a finite non-zero number, got {value!r}")
-    if noise_std is not None and method != "first-moment":
-        raise InputError(f"noise_std applies to method 'first-moment' only, got method={method!r}")
+    for name, given in (("noise_std", noise_std), ("reference_sd", reference_sd)):
+        if given is not None and method != "first-moment":
+            raise InputError(f"{{param}} applies to method 'first-moment' only, got method={method!r}", param=name)
     if noise_std is not None and not np.all(np.asarray(noise_std, dtype=float) > 0):
         raise InputError(f"{{param}} must be > 0 on every axis, got {noise_std!r}: a zero noise would give a zero "
                          "1-sigma", param="noise_std", value=noise_std,
@@ -304,9 +309,10 @@ def calibrate(
         require_constant_rate(rec, used, seg.baseline, method)
     observations = observe_windows(rec, used, reference, value, long_run=long_run and uses_static and noise_std is None,
                                    ripple=long_run and uses_static, times=times, period=period)
-    if angle_var:  # turns across a time-stamp gap: their rate is known within the gap's bound
-        observations = tuple(dataclasses.replace(o, rate_var=angle_var[(w.start, w.stop)] * o.rate**2)
-                             if (w.start, w.stop) in angle_var else o for w, o in zip(used, observations))
+    # turns across a time-stamp gap (their rate known within its bound), and the reference's declared accuracy
+    rel_var = reference_variances(used, reference, value, reference_sd, angle_var)
+    observations = tuple(dataclasses.replace(o, rate_var=v * o.rate**2) if v else o
+                         for v, o in zip(rel_var, observations))
     obs_set = ObservationSet.from_observations(observations)
     fit = estimator.fit(obs_set)
     if checks and uses_static and reference == "angle":  # a wandering axis: the integral is not the rotation
@@ -321,7 +327,12 @@ def calibrate(
         scale = _input_scale(input_units, rec.sensitivity, out_units)
         fit, obs_set, quality, warnings, notes = check_fit(fit, obs_set, estimator, [_label(w) for w in used],
                                                            reference=reference, ctx=ctx, input_scale=scale)
-        warnings[1 if quality.warnings else 0:0] = _single_turns(used, reference, value)
+        warnings[1 if quality.warnings else 0:0] = single_turn_warnings(
+            [w.axis for w in used if w.kind == "rotation"], reference, value)
+        if reference_sd:  # in the file's fit section too
+            size = f"{math.degrees(reference_sd):g} deg" + ("/s" if reference == "speed" else "")
+            notes.append(f"the 1-sigma includes the declared accuracy of every turn's {reference}, {size}")
+            quality = dataclasses.replace(quality, notes=quality.notes + (notes[-1],))
     cal = Calibration(
         model=fit.model,
         input_units=input_units,
@@ -378,20 +389,6 @@ def _spread_blocks(gyro: np.ndarray, sample_rate: float, most: int = 200) -> np.
     if gyro.flags.f_contiguous:  # as read: each axis's blocks are contiguous, and so are the result's columns
         return np.array([c[: blocks * size].reshape(blocks, size)[pick].ravel() for c in gyro.T]).T
     return gyro[: blocks * size].reshape(blocks, size, gyro.shape[1])[pick].reshape(-1, gyro.shape[1])
-
-
-def _single_turns(windows: Sequence[Window], reference: str, declared: float) -> list[str]:
-    """A warning when some scale factor rests on one turn: its residual is zero, nothing checks it."""
-    turns = [w.axis for w in windows if w.kind == "rotation"]
-    alone = [a for a in "xyz" if turns.count(a) == 1]
-    if not alone:
-        return []
-    deg = math.degrees(declared)
-    what = (f"their declared angle (1 deg in {deg:g} is {1 / deg:.2g} in k)" if reference == "angle"
-            else "their declared speed")
-    return [f"the scale factor{'s' if len(alone) > 1 else ''} of {', '.join(alone)} rest{'' if len(alone) > 1 else 's'} "
-            f"on one turn each: nothing in the data checks {what}; turn both ways or repeat the turns so that the "
-            "fit can check itself"]
 
 
 def _label(w: Window) -> str:

@@ -25,7 +25,8 @@ from .segmentation import Segmentation
 from .timebase import Gap, TimeBase
 from .windows import Window
 
-__all__ = ["MAX_GAP_SHARE", "MAX_RATE_CV", "rate_variation", "require_constant_rate", "screen_gaps"]
+__all__ = ["MAX_GAP_SHARE", "MAX_RATE_CV", "rate_variation", "reference_variances", "require_constant_rate",
+           "screen_gaps"]
 
 #: Largest rate variation (sd / mean, noise removed) the paper's methods accept: k low by about 0.5 %.
 MAX_RATE_CV = 0.10
@@ -93,6 +94,28 @@ def screen_gaps(seg: Segmentation, rec: Recording, tb: TimeBase, reference: str,
                            f"{worst.index}); the angle they hide may be {100 * bound / max(turned, 1e-300):.2g} % "
                            f"of the turn (at most {100 * max_share:g} % is accepted)"))
     return dataclasses.replace(seg, windows=tuple(kept), ignored=seg.ignored + tuple(dropped)), rel_var
+
+
+def reference_variances(windows: Sequence[Window], reference: str, value: float, reference_sd: float | None,
+                        gap_var: dict[tuple[int, int], float]) -> list[float]:
+    """Relative variance [1] of every window's reference rate: a gap's bound (:func:`screen_gaps`) plus the
+    declared accuracy of each turn's reference, `reference_sd` [rad of angle, or rad/s of speed]; 0 for
+    static windows.
+
+    A robot or a turntable states its angle (or speed) accuracy; no residual can show an error that all the
+    turns about an axis share, so only a declared accuracy puts it in the 1-sigma.
+    """
+    if reference_sd is not None and not (math.isfinite(reference_sd) and reference_sd >= 0):
+        raise InputError(f"{{param}} must be a finite number >= 0, got {reference_sd!r}", param="reference_sd",
+                         value=reference_sd)
+    out = []
+    for w in windows:
+        rel = gap_var.get((w.start, w.stop), 0.0)
+        if w.kind == "rotation" and reference_sd:
+            size = (w.angle if w.angle is not None else value) if reference == "angle" else value
+            rel += (reference_sd / size) ** 2
+        out.append(rel if w.kind == "rotation" else 0.0)
+    return out
 
 
 def rate_variation(samples: np.ndarray, baseline: np.ndarray) -> float:

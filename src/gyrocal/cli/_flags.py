@@ -136,6 +136,7 @@ NOT_FLAGS: frozenset[str] = frozenset({
     "accel_source_units", "covariance", "correction", "accelerometer", "fit", "observed",
     "chi2", "dof", "p_value", "birge_ratio", "covariance_scaled", "residuals", "warnings", "noise_std_axes",
     "max_abs_rate", "mounting_rotation", "accel_noise_std", "targets",
+    "reference_sd",  # --angle-sd or --speed-sd, checked and converted by the command
 })
 
 

@@ -1,8 +1,8 @@
 """Commands ``calibrate`` and ``segments``: a thin layer over the library.
 
-User units live here and only here: ``--speed`` is in the data's rate unit per
-second, ``--angle`` in degrees, ``--noise-std`` in the data's unit; the library
-gets rad/s and radians.
+User units live in this layer (:mod:`gyrocal.cli._references`): ``--speed`` is in the
+data's rate unit per second, ``--angle`` in degrees, ``--noise-std`` in the data's unit;
+the library gets rad/s and radians.
 
 The commands' own checks raise :class:`~gyrocal.errors.InputError`, so they reach the
 user through the same error boundary as library errors (``run``: one line, exit 2).
@@ -20,6 +20,7 @@ from ..choices import Method
 from ..errors import GyrocalError, InputError
 from ._outputs import check_output, same_document
 from ._reading import READING, read_from_flags, required_units
+from ._references import density_to_internal, noise_to_internal, rate_unit_of, reference_of
 from .app import app, console, message, warn
 
 __all__ = ["calibrate", "segments"]
@@ -37,65 +38,16 @@ Speed = Annotated[Optional[float], typer.Option(
     "for counts) (default: none, --angle 360).")]
 Angle = Annotated[Optional[float], typer.Option(
     "--angle", help="Known angle of each turn, in degrees; the speed may vary (default: 360 unless --speed).")]
+AngleSd = Annotated[Optional[float], typer.Option(
+    "--angle-sd", help="Accuracy (1-sigma) of each turn's angle, in degrees: a robot's or turntable's "
+    "specification, carried into the 1-sigma (default: none, only what the data show).")]
+SpeedSd = Annotated[Optional[float], typer.Option(
+    "--speed-sd", help="Accuracy (1-sigma) of the known speed, in --speed's unit (default: none).")]
 PlotPath = Annotated[Optional[Path], typer.Option(
     "--plot", help="Write a picture (.png, .pdf or .svg) (default: none).")]
 Output = Annotated[Optional[Path], typer.Option(
     "-o", "--output", help="Calibration file to write (default: none; the parameters are printed).")]
 Force = Annotated[bool, typer.Option("--force", help="Replace an output that holds a different calibration.")]
-
-
-def _rate_unit(units: str, output_units: str | None) -> str:
-    """The rate unit of user-facing numbers: --speed, corrected rates (deg/s for counts by default)."""
-    from ..units import parse_rate_unit
-
-    if output_units is not None:
-        return parse_rate_unit(output_units, "output_units")
-    return "deg/s" if units == "counts" else units
-
-
-def _reference(speed: float | None, angle: float | None, rate_unit: str) -> tuple[str, float | None, float | None]:
-    """``(reference, speed [rad/s], angle [rad])`` from the user's flags."""
-    from ..units import unit_factor
-
-    if speed is not None and angle is not None:
-        raise InputError(f"give --speed or --angle, not both (got --speed {speed:g} and --angle {angle:g})")
-    for name, value in (("--speed", speed), ("--angle", angle)):
-        if value is not None and not (math.isfinite(value) and value > 0):
-            raise InputError(f"{name} must be a positive number, got {value:g}")
-    if speed is not None:
-        return "speed", speed * unit_factor(rate_unit), None
-    return "angle", None, math.radians(360.0 if angle is None else angle)
-
-
-def _noise_to_internal(noise_std: float | None, units: str, rate_unit: str, sensitivity: float | None) -> float | None:
-    """--noise-std [the data's unit] in the recording's internal unit."""
-    from ..units import unit_factor
-
-    if noise_std is None:
-        return None
-    if not (math.isfinite(noise_std) and noise_std > 0):
-        raise InputError(f"--noise-std must be a positive number, got {noise_std:g}")
-    if units != "counts":
-        return noise_std * unit_factor(units)
-    return noise_std if sensitivity is None else noise_std / sensitivity * unit_factor(rate_unit)
-
-
-def _density_to_internal(noise_density: str, noise_std: float | None, rec):
-    """--noise-density (rad/s/sqrt(Hz), per axis) as per-sample noise [rad/s] at the recording's rate."""
-    from ..noise_file import noise_density_arg
-
-    if noise_std is not None:
-        raise InputError("give --noise-std or --noise-density, not both")
-    if rec.units == "counts":
-        raise InputError("--noise-density needs physical units; give --sensitivity with --units counts")
-    density = noise_density_arg(noise_density)
-    if not all(d > 0 for d in density):
-        axes = ", ".join(a for a, d in zip("xyz", density) if not d > 0)
-        raise InputError(f"{{param}} {noise_density} gives a zero noise density on {axes}, which would give a zero "
-                         "1-sigma (a noise file of all-zero or constant data?)", param="noise_density",
-                         value=noise_density, hint="measure the noise on a real static log (gyrocal noise), or "
-                         "leave {param} out to estimate it from the windows")
-    return density * math.sqrt(rec.sample_rate)
 
 
 def _windows_from_file(path: Optional[Path], rec):
@@ -223,6 +175,8 @@ def calibrate(
     no_unit_check: READING.NoUnitCheck = False,
     speed: Speed = None,
     angle: Angle = None,
+    angle_sd: AngleSd = None,
+    speed_sd: SpeedSd = None,
     windows: WindowsFile = None,
     method: Annotated[Method, typer.Option("--method", help="Estimator.")] = "first-moment",
     noise_std: Annotated[Optional[float], typer.Option(
@@ -254,17 +208,20 @@ def calibrate(
     if recording is None:
         raise InputError("give a recording to calibrate (or --example for the bundled one)")
     units = required_units(units)
-    rate_unit = _rate_unit(units, output_units)
-    reference, speed_rad, angle_rad = _reference(speed, angle, rate_unit)
+    rate_unit = rate_unit_of(units, output_units)
+    reference, speed_rad, angle_rad, ref_sd = reference_of(speed, angle, rate_unit, speed_sd=speed_sd,
+                                                           angle_sd=angle_sd)
+    if ref_sd is not None and method != "first-moment":
+        raise InputError(f"--{reference}-sd applies to the default method (first-moment), not --method {method}")
     rec = read_from_flags(recording, units=units, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
                           sensitivity=sensitivity, output_units=output_units, topic=topic, saturation=saturation,
                           no_unit_check=no_unit_check)
     win = _windows_from_file(windows, rec)
-    noise = _noise_to_internal(noise_std, units, rate_unit, sensitivity)
+    noise = noise_to_internal(noise_std, units, rate_unit, sensitivity)
     if noise_density is not None:
-        noise = _density_to_internal(noise_density, noise_std, rec)
+        noise = density_to_internal(noise_density, noise_std, rec)
     run = run_calibration(rec, speed=speed_rad, angle=angle_rad, method=method, windows=win, noise_std=noise,
-                          output_units=rate_unit)
+                          output_units=rate_unit, reference_sd=ref_sd)
     cal = run.calibration
     doc = cal.to_document()
     inputs = (Path(recording), windows)
@@ -318,8 +275,8 @@ def segments(
     from rich.table import Table
 
     units = required_units(units)
-    rate_unit = _rate_unit(units, output_units)
-    reference, speed_rad, angle_rad = _reference(speed, angle, rate_unit)
+    rate_unit = rate_unit_of(units, output_units)
+    reference, speed_rad, angle_rad, _ = reference_of(speed, angle, rate_unit)
     check_output(plot, flag="--plot", inputs=(recording, windows), force=True)
     rec = read_from_flags(recording, units=units, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
                           sensitivity=sensitivity, output_units=output_units, topic=topic, saturation=saturation,
