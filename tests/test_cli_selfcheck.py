@@ -121,3 +121,27 @@ def test_simulate_writes_each_defect_with_its_truth(tmp_path):
         assert -11 - 2 < angle - w["angle_deg"] < 2 if gap else abs(angle - w["angle_deg"]) < 2
     line = refused("simulate", "-o", tmp_path / "x.csv", "--late-per-minute", "3")
     assert "--late-per-minute is for --stamps receive" in line
+
+
+def test_simulated_angle_errors_and_their_declared_accuracy(tmp_path):
+    """``simulate --angle-error 0.5``: the truth file's turn sizes differ from 360 by draws of sd 0.5 deg (24
+    draws over 4 seeds: their sd / 0.5 within [0.5, 1.6], where a chi2 with 24 dof falls outside [6, 61] with
+    probability below 1e-3); its windows hold those sizes; ``calibrate --angle 360 --angle-sd 0.5`` says the
+    1-sigma carries it; a turntable and a negative sd are refused."""
+    sizes = []
+    for seed in range(4):
+        out = tmp_path / f"r{seed}.csv"
+        assert invoke("simulate", "-o", out, "--angle-error", "0.5", "--seed", str(seed), "--force")[0] == 0
+        truth = json.loads((tmp_path / f"r{seed}.truth.json").read_text())
+        assert truth["settings"]["angle_error_deg"] == 0.5
+        sizes += [360 * r - 360 for r in truth["settings"]["revolutions"]]
+        turns = [w["angle_deg"] for w in truth["windows"] if w["kind"] == "rotation"]
+        np.testing.assert_allclose(turns, [360 * r for r in truth["settings"]["revolutions"]], rtol=1e-12)
+    assert 0.5 <= np.std(sizes) / 0.5 <= 1.6
+    code, out, err = invoke("calibrate", tmp_path / "r0.csv", "--units", "deg/s", "--angle", "360", "--angle-sd", "0.5")
+    assert code == 0, err
+    assert "declared accuracy of every turn's angle, 0.5 deg" in out
+    assert "does not apply to --protocol turntable" in refused("simulate", "-o", tmp_path / "t.csv", "--protocol",
+                                                                "turntable", "--angle-error", "1")
+    assert "--angle-error must be a number of degrees >= 0" in refused("simulate", "-o", tmp_path / "n.csv",
+                                                                        "--angle-error", "-1")

@@ -27,7 +27,7 @@ _SIMULATED = "gyrocal simulate"  # first words of a simulated recording: a later
 _SERVO = ("servo", "hand")
 #: Flags that only some protocols use; the rest apply to every protocol.
 _PROTOCOL_FLAGS = {
-    **dict.fromkeys(("speed", "turns", "wait", "ramp", "revolutions"), _SERVO),
+    **dict.fromkeys(("speed", "turns", "wait", "ramp", "revolutions", "angle_error"), _SERVO),
     **dict.fromkeys(("vibration", "ripple", "ripple_freq"), ("servo",)),
     "misalignment": (*_SERVO, "multi-position"),
     # the turntable gyro follows the full-temperature-range method's thermal truth
@@ -125,6 +125,10 @@ def simulate(
     ripple: Annotated[float, typer.Option(
         "--ripple", help="Servo: sinusoidal speed ripple, amplitude as a fraction of the speed (0.05 = 5 %).")] = 0.0,
     ripple_freq: Annotated[float, typer.Option("--ripple-freq", help="Servo: frequency of the ripple [Hz].")] = 2.5,
+    angle_error: Annotated[float, typer.Option(
+        "--angle-error", help="Servo/hand: each turn's true angle is off its declared size by a draw of this sd "
+                              "[deg] (a robot's or a hand's angle error; the truth file has the true sizes; "
+                              "calibrate --angle-sd carries it) (default: 0, exact).")] = 0.0,
     stamps: Annotated[TimeStamps, typer.Option(
         "--stamps", help="Time stamps: the sensor's clock, or receive times of a PC reading packets of two samples "
                          "(steps of about 3 and 17 ms at 100 Hz).")] = "sensor",
@@ -202,7 +206,7 @@ def simulate(
     if protocol in _SERVO:
         rec, facts, true_rates = _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misalignment,
                                         sample_rate, rng, settings, revolutions=revolutions, ripple=ripple,
-                                        ripple_freq=ripple_freq)
+                                        ripple_freq=ripple_freq, angle_error=angle_error)
     elif protocol == "multi-position":
         rec, model, facts = multi_position(model, gyro_kw, ctx.params, sample_rate, rng, settings)
     elif protocol == "turntable":
@@ -293,7 +297,7 @@ def _time_defects(rec, facts, settings, stamps, late_per_minute, gaps, gap_lengt
 
 
 def _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misalignment, sample_rate, rng, settings,
-           *, revolutions: str | None = None, ripple: float = 0.0, ripple_freq: float = 2.5):
+           *, revolutions: str | None = None, ripple: float = 0.0, ripple_freq: float = 2.5, angle_error: float = 0.0):
     """A servo or hand session: the recording, its facts and true rates; `settings` gains the protocol's."""
     from ..simulation import VirtualGyro
     from ..simulation.servo import ServoProtocol, simulate_servo
@@ -301,6 +305,11 @@ def _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misali
 
     turn_list = tuple(t.strip() for t in turns.split(",") if t.strip())
     revs = (1.0,) if revolutions is None else tuple(numbers("--revolutions", revolutions))
+    if not (math.isfinite(angle_error) and angle_error >= 0):
+        raise InputError(f"--angle-error must be a number of degrees >= 0, got {angle_error:g}")
+    base = revs * len(turn_list) if len(revs) == 1 else revs
+    if angle_error and len(base) == len(turn_list):  # the true sizes: the declared ones plus one draw per turn
+        revs = tuple(float(r + e / 360.0) for r, e in zip(base, rng.normal(scale=angle_error, size=len(base))))
     kw = dict(speed=math.radians(speed), wait=wait, ramp=ramp, misalignment_deg=misalignment,
               revolutions=revs[0] if len(revs) == 1 else revs)
     proto = (ServoProtocol.hand(turn_list, **kw) if protocol == "hand"
@@ -308,7 +317,7 @@ def _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misali
     rec, truth = simulate_servo(VirtualGyro(model, **gyro_kw), proto, sample_rate=sample_rate, rng=rng)
     settings.update(speed_deg_s=speed, turns=list(turn_list), wait_s=wait, ramp_s=ramp, vibration=vibration,
                     misalignment_deg=misalignment, revolutions=[float(r) for r in proto.turn_angles() / (2 * math.pi)],
-                    ripple=ripple, ripple_freq_hz=ripple_freq)
+                    ripple=ripple, ripple_freq_hz=ripple_freq, angle_error_deg=angle_error)
     return rec, servo_facts(truth), truth.rates
 
 
