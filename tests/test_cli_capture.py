@@ -282,3 +282,12 @@ def test_guided_multi_position_session_with_a_redo(tmp_path):
     np.testing.assert_array_equal(rec.accel, s.accel[: len(rec)])  # ax, ay, az as the device sent them
     z = imu_z_scores(out.with_suffix(".cal.json"), s)
     assert np.all(np.abs(z) <= 4), z
+
+
+def test_capture_without_pyserial_names_the_extra(tmp_path, monkeypatch):
+    """The quick start installs no pyserial: capture must say which extra to install, in one line (exit 2), and
+    leave nothing behind. Reference: the contract of README's extras (a command that needs one says which)."""
+    monkeypatch.setitem(sys.modules, "serial", None)  # import serial now raises ImportError
+    line = refused("capture", "--port", "/dev/ttyACM0", "-o", tmp_path / "rec.csv", "--guide", "servo")
+    assert "needs pyserial" in line and "gyrocal[serial]" in line
+    assert not any(tmp_path.iterdir())

@@ -146,7 +146,7 @@ def require_constant_rate(rec: Recording, windows: Sequence[Window], baseline: n
         cv = rate_variation(rec.gyro[w.start:w.stop], baseline)
         if cv > MAX_RATE_CV:
             raise InputError(
-                f"rotation window {_name(w, i)}: its rate varies {100 * cv:.0f} % (sd/mean, noise removed). "
+                f"rotation {_name(w, i)}: its rate varies {100 * cv:.0f} % (sd/mean, noise removed). "
                 f"{name} (the servo method of Wang et al., eq. 4-8) assumes a constant speed in every window and "
                 f"would read k low by about {50 * cv * cv:.2g} %", param="method", value=method,
                 hint="use the default method ({param} first-moment), which is exact on whole turns, or "

@@ -207,9 +207,9 @@ class Capture:
 
         Whatever ends it, the file holds every sample decoded and is put in place before returning.
         """
+        ser = open_port(self.port, self.baud)  # first: without pyserial it says which extra to install
         import serial
 
-        ser = open_port(self.port, self.baud)
         self.on_event("open", self.port)
         r = self.result
         self._t_wall0 = last_data = last_show = time.monotonic()

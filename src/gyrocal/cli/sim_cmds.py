@@ -162,7 +162,7 @@ def simulate(
     force: Annotated[bool, typer.Option("--force", help="Replace an -o file that gyrocal simulate did not write.")]
     = False,
     device: Annotated[bool, typer.Option(
-        "--device", help="Serve a servo or hand session on a pseudo-terminal as a board would, for 'gyrocal "
+        "--device", help="Serve a servo, hand or multi-position session on a pseudo-terminal as a board would, for 'gyrocal "
                          "capture --port ...' (raw counts at 131 LSB per deg/s; frames are the example firmware's: "
                          "samples, its own six-turn calibration, corrected samples).")] = False,
     wire: Annotated[DeviceWire, typer.Option("--wire", help="--device: gyrocal frames or text lines.")] = "frames",
