@@ -139,7 +139,7 @@ def window_stats(rec, windows, reference, times, *, long_run, ripple):
     out, resid, factor = {}, {}, {}
     for i in plateaus:
         t = clock[span[i][0]:span[i][1]]
-        t = (t - t[0]) / ((t[-1] - t[0]) / (len(t) - 1))
+        t = (t - t[0]) / float(np.median(np.diff(t)))
         level, factor[i], resid[i] = fit_level(blocks[i], t, lines)
         if ripple:
             out[i] = {"level": level}

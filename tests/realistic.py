@@ -169,7 +169,7 @@ def _profile(turn: Turn, fs: float, rng: np.random.Generator) -> np.ndarray:
     cruise = theta / v - tr
     dur = cruise + 2 * tr
     n = max(8, int(math.ceil(dur * fs)))
-    t = np.arange(n + 1) / fs * (dur / (n / fs))  # the sample grid (1 / fs), the profile stretched onto it
+    t = np.arange(n + 1) / fs  # the sample grid (1 / fs); the last step may end past `dur`, at rest
     up = np.clip(t / tr, 0, 1)
     down = np.clip((dur - t) / tr, 0, 1)
     shape = (lambda u: u) if turn.profile == "trapezoid" else (lambda u: 0.5 - 0.5 * np.cos(np.pi * u))

@@ -406,20 +406,22 @@ def test_a_closed_stdout_does_not_cost_the_outputs(tmp_path):
 def test_declared_reference_accuracy_flags(tmp_path):
     """--speed-sd / --angle-sd: the accuracy enters the 1-sigma and the file says so; mixed with the other
     reference, negative, or with the paper's methods, one line and exit 2. Reference: first-order propagation,
-    a plateau's rate known to 0.1 deg/s in 60 adds (0.1 / 60)^2 / 2 to each k's relative variance (two plateaus
-    per axis)."""
+    k is proportional to the speed, so one speed known to 0.1 deg/s in 60 adds exactly (k 0.1 / 60)^2 to each k's
+    variance and the same to every pair's covariance."""
     import json
 
     plain, declared = tmp_path / "plain.json", tmp_path / "declared.json"
     assert invoke("calibrate", "--example", "-o", plain)[0] == 0
     code, out, err = invoke("calibrate", "--example", "--speed-sd", "0.1", "-o", declared)
     assert code == 0, err
-    assert "declared accuracy of every turn's speed, 0.1 deg/s" in out + err
+    assert "declared accuracy of the speed, 0.1 deg/s, common to every plateau" in out + err
     a, b = json.loads(plain.read_text()), json.loads(declared.read_text())
     k = np.array(b["parameters"]["scale_bias"]["k"])
     sd_a = np.array([a["std"][f"k{c}"] for c in "xyz"])
     sd_b = np.array([b["std"][f"k{c}"] for c in "xyz"])
-    assert np.all(sd_b**2 >= sd_a**2 + 0.9 * k**2 * (0.1 / 60) ** 2 / 2)
+    np.testing.assert_allclose(sd_b**2, sd_a**2 + (k * 0.1 / 60) ** 2, rtol=1e-6)
+    cov_a, cov_b = np.array(a["covariance"]), np.array(b["covariance"])
+    np.testing.assert_allclose(cov_b[0, 1] - cov_a[0, 1], k[0] * k[1] * (0.1 / 60) ** 2, rtol=1e-6)
     assert any("declared accuracy" in n for n in b["fit"]["notes"])
     assert "with --speed give --speed-sd" in refused("calibrate", "--example", "--angle-sd", "0.05")
     assert "--speed-sd must be a number >= 0" in refused("calibrate", "--example", "--speed-sd", "-1")

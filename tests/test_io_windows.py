@@ -76,6 +76,7 @@ def test_csv_table(tmp_path):
         ('[{"start": "a", "stop": 9, "kind": "static"}]', "field 'start' must be a number, got 'a'"),
         ('[{"stop": 9, "kind": "static"}]', "needs one of the fields start, t_start"),
         ('[{"start": 1, "stop": 9, "kind": "rotation", "axis": "q"}]', "field 'axis' is 'q'"),
+        ('[{"start": 1, "stop": 9, "kind": "rotation", "angle_deg": 0}]', "field 'angle_deg' is 0; give the size"),
         ('{"x_rot": [1, 2]}', "expected imucal's section list"),
         ("[]", "holds no windows"),
         ("{not json", "not valid JSON"),

@@ -269,3 +269,29 @@ def test_fit_quality_round_trips_through_its_document(rng):
     assert set(doc) >= {"chi2", "dof", "p_value", "birge_ratio", "covariance_scaled", "residuals", "warnings"}
     assert GoodnessOfFit.from_document(doc) == q
     assert len(doc["residuals"]) == len(q.labels) and len(doc["residuals"][0]) == 3  # a static window first
+
+
+def test_each_extra_variance_makes_its_groups_chi2_equal_its_dof():
+    """Reference: the defining equation ``sum r2 / (v + c tau2) = dof``, solved here in closed form for equal
+    rows: four turns of chi2 4 each at 1.74 dof need tau2 = 16 / 1.74 - 1 (the former bracket stopped at 4)."""
+    from gyrocal.excess import _solve_tau2
+
+    r2, v, c = np.full(4, 4.0), np.ones(4), np.ones(4)
+    assert _solve_tau2(r2, v, c, 1.74) == pytest.approx(16 / 1.74 - 1, rel=1e-9)
+    rng = np.random.default_rng(7)
+    for _ in range(50):
+        r2, v, c = rng.chisquare(1, 6) * 5, rng.uniform(0.5, 2, 6), rng.uniform(0.1, 3, 6)
+        tau2 = _solve_tau2(r2, v, c, 2.9)
+        if tau2 > 0:
+            assert np.sum(r2 / (v + c * tau2)) == pytest.approx(2.9, rel=1e-9)
+
+
+def test_every_printed_warning_and_note_is_in_the_file(rng):
+    """A poor gyro (k 55/80/30 % from 1) on a counted time base: the plausibility and time-base warnings the
+    command prints are the file's ``fit.warnings`` too, so a flagged calibration does not look clean there."""
+    gyro = VirtualGyro(ScaleBias([1.55, 1.80, 1.30], B), noise_std=0.01)
+    rec, _ = simulate_servo(gyro, ServoProtocol(misalignment_deg=3), rng=rng)
+    run = calibrate(rec, angle=2 * math.pi)
+    assert any("55 % from 1" in w for w in run.warnings) and any("sample counter" in w for w in run.warnings)
+    assert list(run.calibration.fit["warnings"]) == list(run.warnings)
+    assert list(run.calibration.fit["notes"]) == list(run.notes)

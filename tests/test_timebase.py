@@ -103,3 +103,17 @@ def test_packets_of_four_are_a_rhythm_not_late_deliveries(rng):
     held = realistic.receive_packets(t, 4, np.random.default_rng(3), late_per_minute=6.0)
     tb = analyse_time(held)
     assert 1 <= tb.delayed <= 6 and not tb.gaps and tb.regular_clock
+
+
+@pytest.mark.parametrize("rate", [100.0, 104.0, 208.0, 833.0, 400.0])
+def test_a_sample_counter_is_recognised_with_rounding_and_lost_packets(rate):
+    """Stamps made as ``i / rate`` (a counter times the nominal rate) written with six decimals: counted, also
+    after a lost packet; a crystal 20 ppm off a round rate, and a PC's receive times, are clocks. Reference: how
+    each column was made."""
+    i = np.arange(20_000)
+    counter = np.round(i / rate, 6)
+    assert analyse_time(counter).counted
+    assert analyse_time(np.delete(counter, np.s_[5000:5005])).counted  # five samples lost
+    assert not analyse_time(np.round(i / (rate * (1 + 20e-6)), 6)).counted
+    jitter = np.random.default_rng(int(rate)).uniform(0, 0.3 / rate, len(i))
+    assert not analyse_time(i / rate + jitter).counted

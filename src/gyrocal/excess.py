@@ -86,9 +86,8 @@ class Excess:
 
     def to_document(self, input_scale: float, input_units: str) -> dict:
         """JSON-ready record (the calibration file's ``fit.excess``); levels in the input units."""
-        turn = (math.degrees(self.turn_sd), "deg") if self.reference == "angle" else (
-            math.degrees(self.turn_sd), "deg/s")
-        return {"turn_reference_sd": turn[0], "turn_reference_unit": turn[1],
+        return {"turn_reference_sd": math.degrees(self.turn_sd),
+                "turn_reference_unit": "deg" if self.reference == "angle" else "deg/s",
                 "static_level_sd": (np.asarray(self.static_sd) / input_scale).tolist(), "static_level_unit": input_units,
                 "groups": [{"name": g.name, "chi2": g.chi2, "dof": g.dof, "rows": g.rows} for g in self.groups]}
 
@@ -129,7 +128,9 @@ def _solve_tau2(r2: np.ndarray, v: np.ndarray, c: np.ndarray, dof: float) -> flo
     """The extra variance ``tau2 >= 0`` at which ``sum r2 / (v + c tau2) = dof`` (0 if already below)."""
     if dof <= 0 or not len(r2) or float(np.sum(r2 / v)) <= dof:
         return 0.0
-    lo, hi = 0.0, float(np.max(r2 / c)) if np.any(c > 0) else 0.0
+    grows = c > 0
+    # at hi = sum(r2 / c) / dof the sum is below dof, since each term is below r2 / (c hi): a valid bracket
+    lo, hi = 0.0, float(np.sum(r2[grows] / c[grows])) / dof if np.any(grows) else 0.0
     if hi <= 0:
         return 0.0
     for _ in range(60):  # bisection on a decreasing function: robust, and cheap for a few dozen rows

@@ -12,13 +12,15 @@ import dataclasses
 import math
 from collections.abc import Sequence
 
+import numpy as np
+
 from .estimators import FitResult, window_residuals
 from .excess import widen
 from .observations import ObservationSet
 from .plausibility import Context, check_plausibility
 from .quality import GoodnessOfFit, assess_fit
 
-__all__ = ["check_fit", "single_turn_warnings"]
+__all__ = ["check_fit", "single_turn_warnings", "with_common_scale"]
 
 
 def check_fit(fit: FitResult, obs: ObservationSet, estimator, labels: Sequence[str], *, reference: str,
@@ -44,15 +46,27 @@ def check_fit(fit: FitResult, obs: ObservationSet, estimator, labels: Sequence[s
     return fit, obs, quality, list(quality.warnings) + plausible, list(quality.notes) + notes
 
 
-def single_turn_warnings(axes: Sequence[str], reference: str, declared: float) -> list[str]:
+def single_turn_warnings(axes: Sequence[str], reference: str, declared: float | None) -> list[str]:
     """A warning when some scale factor rests on one turn (`axes`: the turns' axes): its residual is zero,
-    nothing checks it."""
+    nothing checks it. `declared`: the one angle [rad] or speed declared, None for a windows file's angles."""
     alone = [a for a in "xyz" if list(axes).count(a) == 1]
     if not alone:
         return []
-    deg = math.degrees(declared)
-    what = (f"their declared angle (1 deg in {deg:g} is {1 / deg:.2g} in k)" if reference == "angle"
-            else "their declared speed")
-    return [f"the scale factor{'s' if len(alone) > 1 else ''} of {', '.join(alone)} rest{'' if len(alone) > 1 else 's'} "
-            f"on one turn each: nothing in the data checks {what}; turn both ways or repeat the turns so that the "
-            "fit can check itself"]
+    many = len(alone) > 1
+    if reference == "angle" and declared is not None:
+        deg = math.degrees(declared)
+        what = f"its declared angle (1 deg in {deg:g} is {1 / deg:.2g} in k)"
+    else:
+        what = f"its declared {'angle' if reference == 'angle' else 'speed'}"
+    return [f"the scale factor{'s' if many else ''} of {', '.join(alone)} rest{'' if many else 's'} on one turn"
+            f"{' each' if many else ''}: nothing in the data checks {what}; turn both ways or repeat the turns so "
+            "that the fit can check itself"]
+
+
+def with_common_scale(fit: FitResult, rel_sd: float) -> FitResult:
+    """`fit` whose covariance carries a relative error `rel_sd` common to every reference rate (a known speed
+    that is off on every plateau alike): each k moves with it, all three together; b does not."""
+    if fit.covariance is None or not rel_sd:
+        return fit
+    j = np.concatenate([np.asarray(fit.model.k, dtype=float), np.zeros(3)])
+    return dataclasses.replace(fit, covariance=fit.covariance + rel_sd**2 * np.outer(j, j))

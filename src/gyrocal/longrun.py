@@ -2,26 +2,16 @@
 
 ``sigma / sqrt(n)`` holds for white noise only. A plateau of a servo turn also carries the
 servo's speed ripple, and a MEMS gyro's noise is not white at every time scale; both make
-the window mean scatter more. Its variance is the zero-frequency spectral density of the
-readings divided by the window length, estimated here by batch means.
+the window mean scatter more. Here: the ripple's lines found and regressed out of each plateau
+(:func:`find_lines`, :func:`fit_levels`), a Newey-West long-run variance (:func:`newey_west_var`), and the
+variance of span sums that separates sensor noise from a servo's bounded vibration (:func:`span_variance`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["batch_means_var", "block_means", "find_lines", "fit_level", "fit_levels", "newey_west_var", "plateau_mean",
-           "span_variance"]
-
-
-def batch_means_var(x: np.ndarray, batches: int = 10) -> np.ndarray:
-    """Variance of the mean of `x` (n, k) along axis 0 from `batches` non-overlapping batch means."""
-    x = np.asarray(x, dtype=float)
-    n = len(x)
-    b = max(2, min(batches, n // 2))
-    size = n // b
-    m = x[: b * size].reshape(b, size, -1).mean(axis=1)
-    return m.var(axis=0, ddof=1) / b
+__all__ = ["block_means", "find_lines", "fit_level", "fit_levels", "newey_west_var", "span_variance"]
 
 
 def newey_west_var(x: np.ndarray, lags: int | None = None, *, prewhiten: bool = True) -> np.ndarray:
@@ -221,20 +211,3 @@ def block_means(x: np.ndarray, d: int) -> np.ndarray:
         return x[: m * d].reshape(m, d) @ avg
     # column by column, as matrix-vector products: contiguous for column-major windows
     return np.stack([c[: m * d].reshape(m, d) @ avg for c in x.T], axis=1)
-
-
-def plateau_mean(x: np.ndarray, *, lines: list[float] | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Level and its variance [units, units^2] of one steady stretch `x` (n, 3) with a periodic ripple.
-
-    A servo's or robot joint's speed ripple is a sinusoid on top of the level. It is found on the
-    axis that turns (the largest mean) and regressed out together with the level; the level's
-    variance is then that of a regression coefficient under the residuals' long-run variance
-    (Newey-West), so correlated noise counts too. (The pipeline does the same for all plateaus at
-    once, with one set of ripple lines and one long-run variance pooled over them:
-    :func:`gyrocal.window_stats.observe_windows`.)
-    """
-    x = np.asarray(x, dtype=float)
-    if lines is None:
-        lines = find_lines(x[:, int(np.argmax(np.abs(x.mean(axis=0))))])
-    level, factor, resid = fit_level(x, np.arange(len(x), dtype=float), lines)
-    return level, newey_west_var(resid) * len(x) * factor

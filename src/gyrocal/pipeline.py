@@ -25,7 +25,7 @@ import numpy as np
 from .calibration import Calibration
 from .errors import InputError
 from .estimators import FitResult, make_estimator
-from .fit_checks import check_fit, single_turn_warnings
+from .fit_checks import check_fit, single_turn_warnings, with_common_scale
 from .observations import Observation, ObservationSet
 from .observed import quiet_noise
 from .plausibility import Context
@@ -261,8 +261,8 @@ def calibrate(
         ``checks=False, long_run=False`` is the plain estimate on the stamps as they are, with a
         white-noise covariance (benchmarks and tests compare them).
     reference_sd : float, optional
-        First-moment only: the accuracy (1-sigma) of each turn's reference, [rad] or [rad/s] (a robot's
-        specification), carried into the 1-sigma; an error the turns about one axis share shows in no residual.
+        First-moment only: the accuracy (1-sigma) of each turn's angle [rad], independent from turn to turn
+        (a robot's repeatability), or of the one known speed [rad/s], common to every plateau; in the 1-sigma.
 
     Raises
     ------
@@ -310,7 +310,7 @@ def calibrate(
     observations = observe_windows(rec, used, reference, value, long_run=long_run and uses_static and noise_std is None,
                                    ripple=long_run and uses_static, times=times, period=period)
     # turns across a time-stamp gap (their rate known within its bound), and the reference's declared accuracy
-    rel_var = reference_variances(used, reference, value, reference_sd, angle_var)
+    rel_var = reference_variances(used, reference, value, reference_sd if reference == "angle" else None, angle_var)
     observations = tuple(dataclasses.replace(o, rate_var=v * o.rate**2) if v else o
                          for v, o in zip(rel_var, observations))
     obs_set = ObservationSet.from_observations(observations)
@@ -328,11 +328,13 @@ def calibrate(
         fit, obs_set, quality, warnings, notes = check_fit(fit, obs_set, estimator, [_label(w) for w in used],
                                                            reference=reference, ctx=ctx, input_scale=scale)
         warnings[1 if quality.warnings else 0:0] = single_turn_warnings(
-            [w.axis for w in used if w.kind == "rotation"], reference, value)
-        if reference_sd:  # in the file's fit section too
-            size = f"{math.degrees(reference_sd):g} deg" + ("/s" if reference == "speed" else "")
-            notes.append(f"the 1-sigma includes the declared accuracy of every turn's {reference}, {size}")
-            quality = dataclasses.replace(quality, notes=quality.notes + (notes[-1],))
+            [w.axis for w in used if w.kind == "rotation"], reference, None if windows and reference == "angle" else value)
+        if reference_sd:
+            what = ("every turn's angle, {:g} deg" if reference == "angle" else
+                    "the speed, {:g} deg/s, common to every plateau (the three k move together)")
+            notes.append("the 1-sigma includes the declared accuracy of " + what.format(math.degrees(reference_sd)))
+    if reference == "speed" and reference_sd:  # one speed, off on every plateau alike
+        fit = with_common_scale(fit, reference_sd / value)
     cal = Calibration(
         model=fit.model,
         input_units=input_units,
@@ -344,7 +346,8 @@ def calibrate(
         windows=tuple({**w.to_dict(), "rate": o.rate} for w, o in zip(used, observations)),
     )
     if checks:  # the file's sections, built once (freezing thousands of residuals costs)
-        cal = dataclasses.replace(cal, fit=quality.to_document(),
+        # every warning and note printed goes in the file too: a flagged calibration must not look clean there
+        cal = dataclasses.replace(cal, fit={**quality.to_document(), "warnings": list(warnings), "notes": list(notes)},
                                   observed=_observed(rec, tb, fit.noise_std, cal.input_scale, input_units))
     return CalibrationRun(cal, fit, seg, observations, reference, value, quality, tb, tuple(warnings), tuple(notes))
 

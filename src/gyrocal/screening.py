@@ -99,7 +99,7 @@ def screen_gaps(seg: Segmentation, rec: Recording, tb: TimeBase, reference: str,
 def reference_variances(windows: Sequence[Window], reference: str, value: float, reference_sd: float | None,
                         gap_var: dict[tuple[int, int], float]) -> list[float]:
     """Relative variance [1] of every window's reference rate: a gap's bound (:func:`screen_gaps`) plus the
-    declared accuracy of each turn's reference, `reference_sd` [rad of angle, or rad/s of speed]; 0 for
+    declared accuracy of each turn's angle, `reference_sd` [rad] (independent from turn to turn); 0 for
     static windows.
 
     A robot or a turntable states its angle (or speed) accuracy; no residual can show an error that all the
@@ -112,7 +112,7 @@ def reference_variances(windows: Sequence[Window], reference: str, value: float,
     for w in windows:
         rel = gap_var.get((w.start, w.stop), 0.0)
         if w.kind == "rotation" and reference_sd:
-            size = (w.angle if w.angle is not None else value) if reference == "angle" else value
+            size = w.angle if reference == "angle" and math.isfinite(w.angle) else value
             rel += (reference_sd / size) ** 2
         out.append(rel if w.kind == "rotation" else 0.0)
     return out

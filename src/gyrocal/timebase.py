@@ -108,16 +108,17 @@ class TimeBase:
     def counted(self) -> bool:
         """Whether the time is a count of samples at a nominal rate rather than a clock's reading.
 
-        True without a time column (the rate was declared) and for stamps that step by exactly one
-        round period (a whole number of 0.1 Hz): a sample counter times the chip's nominal rate. A
-        chip's own oscillator runs off that rate by a fraction of a per cent or more, and every
-        angle integrated on such a time base carries that error. A PC's receive times (jitter), or
-        a logger's crystal (a period off round by its ppm), measure time.
+        True without a time column (the rate was declared) and for stamps that step by one round period
+        (a whole number of 0.1 Hz), up to a microsecond's rounding (104 Hz written with six decimals), lost
+        samples aside: a sample counter times the chip's nominal rate. A chip's own oscillator runs off
+        that rate by a fraction of a per cent or more, and every angle integrated on such a time base
+        carries that error. A PC's receive times (jitter), or a logger's crystal (a period off round by
+        its ppm), measure time.
         """
         if not self.has_time:
             return True
-        rate = 1.0 / self.period
-        return not self.gaps and self.jitter <= 1e-6 * self.period and abs(rate * 10 - round(rate * 10)) <= 1e-6 * rate
+        rate = (self.n - 1 + self.lost) / self.span  # over the whole log: a microsecond's rounding averages out
+        return self.jitter <= max(1e-6, 1e-6 * self.period) and abs(rate * 10 - round(rate * 10)) <= 1e-6 * rate
 
     @property
     def lost(self) -> int:

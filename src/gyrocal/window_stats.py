@@ -126,7 +126,9 @@ def _plateau_stats(blocks: dict, span: dict, plateaus: list[int], times: np.ndar
         ts = []
         for i in plateaus:
             t = clock[span[i][0]:span[i][1]]
-            ts.append((t - t[0]) / ((t[-1] - t[0]) / (len(t) - 1)))  # block centres on the sample clock, in block steps
+            # block centres on the sample clock, in block steps: the median step, which a gap inside the plateau
+            # does not stretch (its own mean step would, and put the ripple's phase off)
+            ts.append((t - t[0]) / float(np.median(np.diff(t))))
     fits = dict(zip(plateaus, fit_levels([blocks[i] for i in plateaus], ts, lines)))
     out: dict[int, dict] = {i: {"level": fits[i][0]} for i in plateaus} if ripple else {}
     if long_run:

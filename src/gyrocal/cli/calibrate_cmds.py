@@ -42,7 +42,8 @@ AngleSd = Annotated[Optional[float], typer.Option(
     "--angle-sd", help="Accuracy (1-sigma) of each turn's angle, in degrees: a robot's or turntable's "
     "specification, carried into the 1-sigma (default: none, only what the data show).")]
 SpeedSd = Annotated[Optional[float], typer.Option(
-    "--speed-sd", help="Accuracy (1-sigma) of the known speed, in --speed's unit (default: none).")]
+    "--speed-sd", help="Accuracy (1-sigma) of the known speed, in --speed's unit: one error common to every "
+    "plateau, so the three k move together (default: none).")]
 PlotPath = Annotated[Optional[Path], typer.Option(
     "--plot", help="Write a picture (.png, .pdf or .svg) (default: none).")]
 Output = Annotated[Optional[Path], typer.Option(

@@ -179,6 +179,9 @@ def _window(rec: dict, i: int, clock: _Clock, source: str) -> Window:
         axis = None
     angle = math.radians(_number(rec, "angle_deg", where)) if rec.get("angle_deg") not in (None, "") else math.nan
     rate = _number(rec, "rate", where) if rec.get("rate") not in (None, "") else math.nan
+    if kind == "rotation" and angle == 0:
+        raise FileFormatError(f"{where}: field 'angle_deg' is 0; give the size of the turn in degrees (or leave it "
+                              "out to use --angle)", "angle_deg")
     if start < 0 or stop <= start:
         raise FileFormatError(f"{where}: needs 0 <= start < stop, got {start}:{stop}", "start")
     if kind == "static":
