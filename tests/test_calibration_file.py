@@ -88,8 +88,11 @@ def write(tmp_path, doc) -> str:
         (lambda d: d.update(fit={"chi2": -1.0}), "fit.chi2"),
         (lambda d: d.update(fit=[1]), "fit"),
         (lambda d: d.update(observed={"sample_rate": "fast"}), "observed.sample_rate"),
-        (lambda d: d.update(accelerometer={"correction": {"matrix": [1], "offset": [0, 0, 0]}}),
+        (lambda d: d.update(accelerometer={"units": {"input": "m/s^2", "output": "m/s^2"},
+                                           "correction": {"matrix": [1], "offset": [0, 0, 0]}}),
          "accelerometer.correction.matrix"),
+        (lambda d: d.update(accelerometer={"correction": {"matrix": np.eye(3).tolist(), "offset": [0, 0, 0]}}),
+         "accelerometer.units"),
     ],
 )
 def test_malformed_files_name_the_field(rng, tmp_path, edit, field):

@@ -116,3 +116,26 @@ def test_not_a_flight_log(tmp_path):
     bad.write_bytes(b"\x00" * 64)
     with pytest.raises(InputError, match="x.bin: .*DataFlash"):
         read_flight_log(bad)
+
+
+@pytest.mark.parametrize("command", [["calibrate"], ["segments"], ["imu", "--accel-units", "m/s^2"],
+                                     ["apply", "CAL", "LOG", "-o", "OUT"],
+                                     ["verify", "CAL", "LOG", "--reference", "REF", "--ref-units", "deg/s", "-o", "DIR"]])
+def test_every_reading_command_takes_imu_for_a_log_of_several(command, tmp_path):
+    """PX4's sample log holds three IMUs: the refusal names --imu, and every command that reads a recording takes
+    it (before, only noise and thermal-bias did, so the advice could not be followed). Reference: the log's three
+    instances, read by pyulog."""
+    from cli_runner import invoke, refused
+
+    assert invoke("calibrate", "--example", "-o", tmp_path / "cal.json")[0] == 0
+    assert invoke("simulate", "-o", tmp_path / "ref.csv")[0] == 0
+    names = {"CAL": tmp_path / "cal.json", "LOG": ULOG, "REF": tmp_path / "ref.csv", "OUT": tmp_path / "o.csv",
+             "DIR": tmp_path / "v"}
+    args = [names.get(a, a) for a in command]
+    if "LOG" not in command:
+        args.insert(1, ULOG)
+    args += ["--units", "rad/s", "--no-unit-check"]
+    line = refused(*args)
+    assert "3 IMUs in this log" in line and "--imu N" in line
+    code, out, err = invoke(*args, "--imu", "0")
+    assert "IMUs in this log" not in err and "no such option" not in err

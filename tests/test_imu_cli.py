@@ -241,8 +241,31 @@ def test_a_wrong_declared_unit_is_pointed_out(session, tmp_path):
     rec, _, _, _ = session
     code, _, err = invoke("imu", rec, "--units", "rad/s", "--no-unit-check", "--accel-units", "g")
     assert code == 0, err
-    assert "is the gyro's unit right? (57.3: deg/s read as rad/s)" in err
-    assert "is --accel-units g right? (9.8: g read as m/s^2)" in err
+    assert "is --units rad/s right? (a factor 1/57.3: data in deg/s read as rad/s)" in err
+    assert "is --accel-units g right? (a factor 1/9.81: data in m/s^2 read as g)" in err
+    # the units right and an output unit of its own: the correction is 57.3 deg/s per rad/s, and no warning
+    data = read_recording(rec, units="deg/s", accel_units="m/s^2")
+    as_rad = tmp_path / "rad.csv"
+    as_rad.write_text("t,gx,gy,gz,ax,ay,az\n" + "".join(
+        f"{t:.6f},{x:.9f},{y:.9f},{z:.9f},{a:.6f},{b:.6f},{c:.6f}\n" for t, (x, y, z), (a, b, c) in
+        zip(data.t, data.gyro, data.accel)))
+    code, _, err = invoke("imu", as_rad, "--units", "rad/s", "--output-units", "deg/s", "--accel-units", "m/s^2")
+    assert code == 0, err
+    assert "right?" not in err
+
+
+def test_a_model_taken_with_too_few_poses_to_check_it_warns(tmp_path):
+    """8 poses: the accelerometer falls back to scale and offset with 2 spare equations, which cannot show the
+    non-orthogonality it leaves out (the simulator's truth has it): a warning says so and how to fix it; 20 poses
+    check the full model and do not warn. Reference: the model choice the fit prints."""
+    for poses, warned in ((8, True), (20, False)):
+        rec = tmp_path / f"p{poses}.csv"
+        assert invoke("simulate", "--protocol", "multi-position", "-o", rec, "--poses", str(poses), "--sample-rate",
+                      "100", "--seed", "2", "--force")[0] == 0
+        code, out, err = invoke("imu", rec, "--units", "deg/s", "--accel-units", "m/s^2")
+        assert code == 0, err
+        assert ("accelerometer model was fitted with too few spare equations" in err) == warned
+        assert ("too few to check it" in out) == warned
 
 
 def test_g_sensitivity_flag_and_its_place_in_the_file(session, tmp_path):
@@ -263,3 +286,51 @@ def test_imucal_export_needs_both_sensors(tmp_path):
     assert code == 0, err
     line = refused("export", tmp_path / "gyro.json", "--format", "imucal", "-o", tmp_path / "x.json")
     assert "imucal's format holds the accelerometer and the gyro" in line and "gyrocal imu" in line
+
+
+def test_a_simulated_hand_session_with_receive_stamps_and_gaps_keeps_its_accelerometer(tmp_path):
+    """``simulate --protocol multi-position --stamps receive --gaps 2``: the log a PC's USB reader makes, lost
+    packets included, still has ax ay az (they were dropped before), and ``gyrocal imu`` calibrates it. Reference:
+    the rows the gyro keeps are the accelerometer's (same count)."""
+    rec = tmp_path / "recv.csv"
+    code, _, err = invoke("simulate", "--protocol", "multi-position", "-o", rec, "--sample-rate", "100", "--seed", "3",
+                          "--stamps", "receive", "--late-per-minute", "5", "--gaps", "2")
+    assert code == 0, err
+    data = read_recording(rec, units="deg/s", accel_units="m/s^2")
+    assert data.accel is not None and len(data.accel) == len(data.gyro)
+    code, _, err = invoke("imu", rec, "--units", "deg/s", "--accel-units", "m/s^2")
+    assert code == 0, err
+
+
+def test_apply_an_imu_calibration_to_a_gyro_only_log(session, tmp_path):
+    """A flight log of the same gyro without accelerometer columns: the calibration has no g-sensitivity, so its
+    gyro correction needs no accelerometer; apply corrects the gyro and says the accelerometer part is unused.
+    Reference: the gyro columns of the same log applied with its accelerometer (identical)."""
+    rec, cal, _, _ = session
+    lines = rec.read_text().splitlines()
+    head = next(i for i, ln in enumerate(lines) if not ln.startswith("#"))
+    gyro_only = tmp_path / "gyro.csv"
+    gyro_only.write_text("\n".join(",".join(ln.split(",")[:4]) for ln in lines[head:]) + "\n")
+    code, out, err = invoke("apply", cal, gyro_only, "-o", tmp_path / "a.csv")
+    assert code == 0, err
+    assert "has no ax ay az: the gyro is corrected" in out
+    assert invoke("apply", cal, rec, "-o", tmp_path / "b.csv")[0] == 0
+    a = np.loadtxt(tmp_path / "a.csv", delimiter=",", comments="#", skiprows=2)[:, 1:4]
+    b = np.loadtxt(tmp_path / "b.csv", delimiter=",", comments="#", skiprows=2)[:, 1:4]
+    np.testing.assert_array_equal(a, b)
+    # asked for explicitly, the accelerometer must be there
+    assert "no accelerometer column" in refused("apply", cal, gyro_only, "-o", tmp_path / "c.csv", "--accel-units",
+                                                "m/s^2")
+
+
+def test_a_headerless_imu_log_is_told_the_accelerometer_columns_too(session, tmp_path):
+    """The refusal of a headerless 7-column log names ax ay az as well, so the mapping it suggests reads it."""
+    rec = session[0]
+    lines = [ln for ln in rec.read_text().splitlines() if not ln.startswith("#")][1:]
+    bare = tmp_path / "bare.txt"
+    bare.write_text("\n".join(ln.replace(",", " ") for ln in lines) + "\n")
+    line = refused("imu", bare, "--units", "deg/s", "--accel-units", "m/s^2")
+    assert "--columns t=1,gx=2,gy=3,gz=4,ax=5,ay=6,az=7" in line
+    code, _, err = invoke("imu", bare, "--units", "deg/s", "--accel-units", "m/s^2", "--columns",
+                          "t=1,gx=2,gy=3,gz=4,ax=5,ay=6,az=7")
+    assert code == 0, err

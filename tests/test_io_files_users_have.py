@@ -275,3 +275,21 @@ def test_units_row_under_the_header_is_skipped_and_a_bad_first_row_is_not(tmp_pa
     (tmp_path / "bad.csv").write_text("t,gx,gy,gz\n0,oops,x,y\n" + _text(t[1:], g[1:], header=""))
     with pytest.raises(InputError, match=r"column 'gx' holds non-numeric cell 'oops' at data row 1"):
         read_csv_columns(tmp_path / "bad.csv", use_pyarrow=use_pyarrow)
+
+
+def test_packet_receive_stamps_shared_by_two_samples_are_named(tmp_path):
+    """Two samples per USB packet, both stamped with its receive time: the refusal says what the ties are and how
+    to read the log (no time column, a declared rate), not to drop half the rows; one repeated row keeps the
+    sort-and-drop advice. Reference: how the stamps were made."""
+    from gyrocal.io import read_recording
+
+    t = np.repeat(np.arange(200) * 0.02, 2)
+    rows = "".join(f"{a:.3f},0.1,0.2,0.3\n" for a in t)
+    path = tmp_path / "pairs.csv"
+    path.write_text("t,gx,gy,gz\n" + rows)
+    with pytest.raises(InputError, match="samples of one packet stamped with its receive time"):
+        read_recording(path, units="deg/s")
+    single = tmp_path / "one.csv"
+    single.write_text("t,gx,gy,gz\n" + "".join(f"{a:.3f},0.1,0.2,0.3\n" for a in [0.0, 0.01, 0.01, *np.arange(3, 200) * 0.01]))
+    with pytest.raises(InputError, match="sort the log and drop repeated rows"):
+        read_recording(single, units="deg/s")

@@ -95,9 +95,12 @@ def render(obj_or_path: Any, fmt: str, **options) -> str:
 
         obj = load(obj_or_path)
     if ex.kinds is not None and not isinstance(obj, ex.kinds):
-        names = ", ".join(getattr(k, "FORMAT", k.__name__) for k in ex.kinds)
-        raise InputError(f"{fmt} export takes {names}, not {getattr(obj, 'FORMAT', type(obj).__name__)}",
-                         param="fmt", value=fmt)
+        formats = [getattr(k, "FORMAT", k.__name__) for k in ex.kinds]
+        made_by = {"gyrocal.noise": "gyrocal noise LOG --json noise.json", "gyrocal.thermal-bias":
+                   "gyrocal thermal-bias LOG -o bias.json", "gyrocal.thermal": "gyrocal thermal SESSION -o thermal.json"}
+        how = "; ".join(f"{f} is made by '{made_by[f]}'" for f in formats if f in made_by)
+        raise InputError(f"{fmt} export takes {', '.join(formats)}, not {getattr(obj, 'FORMAT', type(obj).__name__)}"
+                         + (f" ({how})" if how else ""), param="fmt", value=fmt)
     return ex.fn(obj, **options)
 
 

@@ -240,6 +240,10 @@ class AccelerometerPart(Section):
     @classmethod
     def _problem(cls, frozen: Mapping[str, Any]) -> tuple[str, str] | None:
         problem = super()._problem(frozen)
+        for key, inner in (("units", ("input", "output")), ("correction", ("matrix", "offset"))):
+            # what apply and the exporters need: a part without them could only be skipped, or crash
+            if problem is None and (frozen.get(key) is None or any(k not in frozen[key] for k in inner)):
+                problem = key, f"must be an object with {' and '.join(inner)} (the file is not a gyrocal imu result)"
         corr = frozen.get("correction")
         if problem is None and corr is not None:
             for key, shape in (("matrix", (3, 3)), ("offset", (3,))):

@@ -34,6 +34,7 @@ def apply(
     topic: READING.Topic = None,
     saturation: READING.Saturation = "error",
     no_unit_check: READING.NoUnitCheck = False,
+    imu: READING.Imu = None,
     accel_units: READING.AccelUnits = None,
     accel_sensitivity: READING.AccelSensitivity = None,
     gravity: READING.Gravity = 9.80665,
@@ -59,10 +60,21 @@ def apply(
                          f"corrected already, and {calibration.name} would correct them twice",
                          hint="give the raw recording, or --force to correct it again")
     unit = _unit(units, cal, calibration)
+    asked = accel_units is not None
     accel_units, gravity = _accel_reading(ctx, cal, accel_units, gravity)
-    rec = read_from_flags(recording, units=unit, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
-                          topic=topic, saturation=saturation, no_unit_check=no_unit_check, accel_units=accel_units,
-                          accel_sensitivity=accel_sensitivity, gravity=gravity)
+    read = dict(units=unit, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate, topic=topic,
+                saturation=saturation, no_unit_check=no_unit_check, imu=imu)
+    try:
+        rec = read_from_flags(recording, **read, accel_units=accel_units, accel_sensitivity=accel_sensitivity,
+                              gravity=gravity)
+    except InputError as exc:
+        # a gyro-only log and an IMU calibration whose gyro does not need the accelerometer: correct the gyro
+        part = getattr(cal, "accelerometer", None)
+        if asked or part is None or part.get("gyro_g_sensitivity") or "no accelerometer column" not in str(exc):
+            raise
+        rec = read_from_flags(recording, **read)
+        console.print(f"note: {recording.name} has no ax ay az: the gyro is corrected, the calibration's "
+                      "accelerometer part is not used", highlight=False, soft_wrap=True)
     if not no_unit_check and getattr(cal, "observed", None) is not None:
         from ..observed import check_observed
 

@@ -174,6 +174,7 @@ def calibrate(
     topic: READING.Topic = None,
     saturation: READING.Saturation = "error",
     no_unit_check: READING.NoUnitCheck = False,
+    imu: READING.Imu = None,
     speed: Speed = None,
     angle: Angle = None,
     angle_sd: AngleSd = None,
@@ -216,7 +217,7 @@ def calibrate(
         raise InputError(f"--{reference}-sd applies to the default method (first-moment), not --method {method}")
     rec = read_from_flags(recording, units=units, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
                           sensitivity=sensitivity, output_units=output_units, topic=topic, saturation=saturation,
-                          no_unit_check=no_unit_check)
+                          no_unit_check=no_unit_check, imu=imu)
     win = _windows_from_file(windows, rec)
     noise = noise_to_internal(noise_std, units, rate_unit, sensitivity)
     if noise_density is not None:
@@ -265,6 +266,7 @@ def segments(
     topic: READING.Topic = None,
     saturation: READING.Saturation = "error",
     no_unit_check: READING.NoUnitCheck = False,
+    imu: READING.Imu = None,
     speed: Speed = None,
     angle: Angle = None,
     windows: WindowsFile = None,
@@ -281,7 +283,7 @@ def segments(
     check_output(plot, flag="--plot", inputs=(recording, windows), force=True)
     rec = read_from_flags(recording, units=units, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
                           sensitivity=sensitivity, output_units=output_units, topic=topic, saturation=saturation,
-                          no_unit_check=no_unit_check)
+                          no_unit_check=no_unit_check, imu=imu)
     given = _windows_from_file(windows, rec)
     ignored: list = []
     if given is not None:

@@ -28,6 +28,7 @@ def imu(
     topic: READING.Topic = None,
     saturation: READING.Saturation = "error",
     no_unit_check: READING.NoUnitCheck = False,
+    imu: READING.Imu = None,
     accel_units: READING.AccelUnits = None,
     accel_sensitivity: READING.AccelSensitivity = None,
     gravity: READING.Gravity = 9.80665,
@@ -72,7 +73,7 @@ def imu(
     check_output(plot, flag="--plot", inputs=(recording, windows, output, accel_log), outputs=(output,), force=True)
     rec = read_from_flags(recording, units=units, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
                           sensitivity=sensitivity, output_units=output_units, topic=topic, saturation=saturation,
-                          no_unit_check=no_unit_check, accel_units=None if accel_log else accel_units,
+                          no_unit_check=no_unit_check, imu=imu, accel_units=None if accel_log else accel_units,
                           accel_sensitivity=None if accel_log else accel_sensitivity, gravity=gravity,
                           need_accel=accel_log is None)
     if accel_log is not None:

@@ -44,7 +44,7 @@ def _stretch(text: str | None) -> tuple[float, float] | None:
     return lo, hi
 
 
-def _read_test(path: Path, cal, units, columns, skip_rows, sample_rate, topic, saturation, no_unit_check):
+def _read_test(path: Path, cal, units, columns, skip_rows, sample_rate, topic, saturation, no_unit_check, imu):
     """The test log: rates in any rate unit (they are physical), or counts for a counts calibration,
     with its sensitivity when it has one (so the raw rates before calibration are known)."""
     from ..units import parse_input_unit
@@ -60,7 +60,7 @@ def _read_test(path: Path, cal, units, columns, skip_rows, sample_rate, topic, s
     return read_from_flags(path, units=unit, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
                            sensitivity=sensitivity if unit == "counts" else None,
                            output_units=cal.output_units if unit == "counts" and sensitivity else None, topic=topic,
-                           saturation=saturation, no_unit_check=no_unit_check)
+                           saturation=saturation, no_unit_check=no_unit_check, imu=imu)
 
 
 def _read_reference(path: Path, units, columns, skip_rows, sample_rate, sensitivity, topic, saturation, no_unit_check):
@@ -153,6 +153,7 @@ def verify(
     topic: READING.Topic = None,
     saturation: READING.Saturation = "error",
     no_unit_check: READING.NoUnitCheck = False,
+    imu: READING.Imu = None,
     ref_units: REF.Units = None,
     ref_columns: REF.Columns = None,
     ref_skip_rows: REF.SkipRows = None,
@@ -196,7 +197,7 @@ def verify(
                          "same motion")
     span = _stretch(stretch)
     cal = load_correction(calibration)
-    rec = _read_test(test, cal, units, columns, skip_rows, sample_rate, topic, saturation, no_unit_check)
+    rec = _read_test(test, cal, units, columns, skip_rows, sample_rate, topic, saturation, no_unit_check, imu)
     ref = _read_reference(reference, ref_units, ref_columns, ref_skip_rows, ref_sample_rate, ref_sensitivity,
                           ref_topic, ref_saturation, ref_no_unit_check)
     options = {name: value for name, value in (("model", model), ("out_of_range", out_of_range)) if given(ctx, name)}

@@ -50,6 +50,20 @@ def _finite_or_none(x: float) -> float | None:
     return float(x) if np.isfinite(x) else None
 
 
+#: How a model choice says it took a model with too few spare equations (:func:`unchecked_warning`).
+UNCHECKED = "too few to check it"
+
+
+def unchecked_warning(sensor: str, choice) -> list[str]:
+    """A warning when the `sensor`'s model was taken with too few spare equations to check it."""
+    line = next((c for c in choice if UNCHECKED in c), None)
+    if line is None:
+        return []
+    return [f"the {sensor} model was fitted with too few spare equations to check it ({line}): its 1-sigma leaves "
+            "out what the larger models fit (a real sensor's axes are a few tenths of a degree from orthogonal), so "
+            "it may be several sigmas off; add poses (a dozen or more) so that the full model can check itself"]
+
+
 def quality(residuals: np.ndarray, n_params: int, what: str) -> FitQuality:
     """Chi-square of normalised `residuals` with `n_params` fitted; `what` names the fit in warnings."""
     r = np.asarray(residuals, dtype=float)

@@ -345,7 +345,7 @@ def fit_accelerometer(means, se, *, gravity: float = 9.80665, model: AccelModel 
         choice.append(f"{m}: {why}")
     if fallback is not None:
         m, a, o, cov, r, q, i, gain = fallback
-        choice[i] = f"{m}: fitted with {q.dof} spare equation(s), too few to check it"
+        choice[i] = f"{m}: fitted with {q.dof} spare equation(s), {_fit.UNCHECKED}"
         return _result(m, a, o, cov, gravity, r, q, u, se, choice, gain)
     raise DegenerateDesignError(_too_few_message(u, choice))
 

@@ -273,7 +273,7 @@ def _choose(prob: GyroProblem, model, ctx: _Context) -> GyroFit:
         choice.append(f"{m}: {why}")
     if fallback is not None:
         solution, prob.factors, i = fallback
-        choice[i] = f"{solution[0]}: fitted with {solution[4].dof} spare equation(s), too few to check it"
+        choice[i] = f"{solution[0]}: fitted with {solution[4].dof} spare equation(s), {_fit.UNCHECKED}"
         return _finish(prob, solution, choice, ctx)
     raise DegenerateDesignError("the turns between the still poses determine no gyro model: "
                                 + "; ".join(choice) + "; turn the board about each of its axes between poses")

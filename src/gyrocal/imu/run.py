@@ -64,18 +64,29 @@ def plausibility(cal: Calibration) -> tuple[str, ...]:
     """Warnings for scale factors far from 1 when both ends are physical units (a wrong --units or --accel-units)."""
     out = []
     if cal.input_units != "counts":
-        k = np.abs(np.diag(cal.correction[0]))
+        k = np.abs(np.diag(np.asarray(cal.model.matrix, dtype=float)))  # internal (rad/s per rad/s as read)
         if np.any(np.abs(k - 1) > SCALE_PLAUSIBLE):
-            out.append(f"the gyro's scale factors are {', '.join(f'{v:.4g}' for v in k)} {cal.output_units} per "
-                       f"{cal.input_units}, far from 1: is the gyro's unit right? (57.3: deg/s read as rad/s)")
+            out.append(f"the gyro's scale factors are {', '.join(f'{v:.4g}' for v in k)} (rad/s per rad/s as read), far "
+                       f"from 1: is --units {cal.input_units} right?{_unit_hint(k, 180 / np.pi, 'rad/s', 'deg/s')}")
     part = cal.accelerometer
     if part is not None and part["units"]["input"] != "counts":
         units = part["units"]
         k = np.abs(np.diag(np.asarray(part["parameters"]["matrix"], dtype=float)))  # m/s^2 per m/s^2 as read
         if np.any(np.abs(k - 1) > SCALE_PLAUSIBLE):
             out.append(f"the accelerometer's scale factors are {', '.join(f'{v:.4g}' for v in k)}, far from 1: is "
-                       f"--accel-units {units['input']} right? (9.8: g read as m/s^2)")
+                       f"--accel-units {units['input']} right?{_unit_hint(k, 9.80665, 'g', 'm/s^2')}")
     return tuple(out)
+
+
+def _unit_hint(k: np.ndarray, factor: float, big: str, small: str) -> str:
+    """Which unit mix-up a common factor near `factor` (or its inverse) points to: ``big`` is `factor` times
+    ``small`` (rad/s = 57.3 deg/s, g = 9.81 m/s^2)."""
+    ratio = float(np.median(k))
+    if abs(ratio / factor - 1) < 0.2:
+        return f" (a factor {factor:.3g}: data in {big} read as {small})"
+    if abs(ratio * factor - 1) < 0.2:
+        return f" (a factor 1/{factor:.3g}: data in {small} read as {big})"
+    return ""
 
 
 def accel_scale(units: str, sensitivity: float | None, gravity: float) -> float:

@@ -25,6 +25,7 @@ import numpy as np
 from .._validation import at_least, finite_array, positive
 from ..errors import InputError, SegmentationError
 from ..windows import Window
+from ._fit import unchecked_warning
 from .accel import AccelFit, fit_accelerometer
 from .gyro import GyroFit, Turn, fit_gyroscope
 from .poses import Coverage, coverage
@@ -197,7 +198,8 @@ def calibrate_imu(t, gyro, accel, *, gravity: float = 9.80665, windows: Sequence
     gfit = fit_gyroscope(t, gyro, force, statics, afit, pairs=pairs, turns=turns, model=gyro_model,
                          g_sensitivity=g_sensitivity)
     cov = coverage(afit.directions)
-    warnings = list(afit.fit.warnings) + notes + list(gfit.fit.warnings)
+    warnings = (list(afit.fit.warnings) + unchecked_warning("accelerometer", afit.choice) + notes
+                + list(gfit.fit.warnings) + unchecked_warning("gyro", gfit.choice))
     if cov.spread < _POOR_SPREAD and not ferraris:
         warnings.append(f"the poses cover the sphere poorly (spread {cov.spread:.2f} of 1); add poses with the "
                         f"sensor direction ({', '.join(f'{v:+.2f}' for v in cov.weakest_axis)}) up or down")

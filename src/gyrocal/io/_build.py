@@ -54,11 +54,16 @@ def _check_time(t: np.ndarray, source: str) -> float:
     increasing = t[1:] > t[:-1]
     if not increasing.all():
         i = int(np.argmin(increasing))
-        what = "a duplicated timestamp" if t[i + 1] == t[i] else "time going backwards"
+        tied = t[i + 1] == t[i]
+        ties = int(np.count_nonzero(t[1:] == t[:-1])) if tied else 0
+        fix = ("sort the log and drop repeated rows" if ties * 20 < len(t) else
+               # many ties: samples of one packet stamped with its receive time, not repeated rows
+               f"{ties} rows share their time with the one before: samples of one packet stamped with its receive "
+               "time? Leave the time column out (--columns without t) and give --sample-rate, or stamp each sample")
         raise InputError(
             # float(): plain numbers, not numpy reprs; str keeps every digit of epoch stamps
-            f"{source}: {what} at data row {i + 2} (t={float(t[i])} then {float(t[i + 1])}); "
-            "times must increase strictly: sort the log and drop repeated rows"
+            f"{source}: {'a duplicated timestamp' if tied else 'time going backwards'} at data row {i + 2} "
+            f"(t={float(t[i])} then {float(t[i + 1])}); times must increase strictly: {fix}"
         )
     # the mean step of the sensor clock, robust to gaps (gyrocal.timebase): never the median step of bursty
     # receive-time stamps, and block means of 64 steps average away the 0.24 us quantum of epoch stamps

@@ -61,7 +61,7 @@ def _head(path: Path, packed: str | None, skip_rows: int | None = None) -> tuple
     return (lines[:-1] if len(raw) % _HEAD_BYTES == 0 and len(lines) > 1 else lines), encoding  # the last line may be cut
 
 
-def _headerless(path: Path, lines: list[str], layout: Layout) -> InputError:
+def _headerless(path: Path, lines: list[str], layout: Layout, accel: bool = False) -> InputError:
     """The refusal of a table without a header when no columns are given, with the mapping to type."""
     first = lines[layout.data]
     rows = [split(line, layout.delimiter) for line in lines[layout.data:layout.data + 50] if line.strip()]
@@ -71,6 +71,8 @@ def _headerless(path: Path, lines: list[str], layout: Layout) -> InputError:
     except (ValueError, IndexError):
         timed = False
     numbers = "t=1,gx=2,gy=3,gz=4" if timed else "gx=1,gy=2,gz=3"
+    if accel:  # the accelerometer's three columns after the gyro's
+        numbers += ",ax=5,ay=6,az=7" if timed else ",ax=4,ay=5,az=6"
     sep = layout.delimiter or " "
     return InputError(
         f"{path.name}: the first line ({first[:40].strip()!r}) is data, not a header", param="columns",
@@ -130,7 +132,7 @@ def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool
     lines, encoding = _head(path, packed, skip_rows)
     layout = find_layout(lines, path.name, skip_rows)
     if layout.header is None and not columns:
-        raise _headerless(path, lines, layout)
+        raise _headerless(path, lines, layout, accel)
     layout, mapping = _mapped(path, lines, layout, columns, accel)
     names = layout.names
     if use_pyarrow is None:

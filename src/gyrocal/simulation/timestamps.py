@@ -147,6 +147,8 @@ def with_time_defects(
         table_rate=None if rec.table_rate is None else rec.table_rate[keep],
         axis=None if rec.axis is None else rec.axis[keep],
         extra={k: np.asarray(v)[keep] for k, v in rec.extra.items()}, sensitivity=rec.sensitivity,
+        accel=None if rec.accel is None else rec.accel[keep], accel_units=rec.accel_units,
+        accel_source_units=rec.accel_source_units, accel_sensitivity=rec.accel_sensitivity,
     )
     return out, truth
 
