@@ -129,6 +129,24 @@ def test_verify_refuses_static_logs(bench, tmp_path):
     assert "no motion to align on" in refused(*_verify_args(tmp_path, "--ref-units", "deg/s"))
 
 
+def test_verify_names_the_reference_unit_or_its_short_span_not_the_motion(bench, tmp_path):
+    """Reference: the simulated pair's truth. The bench's reference written in rad/s but declared deg/s
+    is 57.3 times too small (the deg/rad factor), and its first third covers 33 % of the test log; the
+    refusals must name --ref-units rad/s and the short reference, not a repeating motion."""
+    folder, pair = bench
+    (tmp_path / "test.csv").write_text((folder / "test.csv").read_text())
+    save(Calibration(model=TRUE, input_units="deg/s", output_units="deg/s"), tmp_path / "cal.json")
+    write_recording(tmp_path / "ref.csv", pair.ref, units="rad/s")
+    line = refused(*_verify_args(tmp_path, "--ref-units", "deg/s", "--no-figures"))
+    assert "57." in line and "times smaller" in line and "give --ref-units rad/s" in line and "repeats" not in line
+    third = type(pair.ref)(t=pair.ref.t[:len(pair.ref.t) // 3], gyro=pair.ref.gyro[:len(pair.ref.t) // 3],
+                           sample_rate=100.0)
+    write_recording(tmp_path / "ref.csv", third, units="deg/s")
+    line = refused(*_verify_args(tmp_path, "--ref-units", "deg/s", "--no-figures"))
+    assert "the reference log covers only 33 % of the test log" in line and "repeats" not in line
+    assert not (tmp_path / "bad").exists()
+
+
 def test_verify_needs_a_calibration_file(bench, tmp_path):
     folder, _ = bench
     save(SimulationTruth(protocol="servo", model=TRUE), tmp_path / "truth.json")
