@@ -118,6 +118,26 @@ def warm(tmp_path_factory):
     return rec
 
 
+def test_noise_on_a_warming_board_warns_and_records_the_temperature_span(warm, rest, tmp_path):
+    """Reference: the simulator's warm-up in closed form, T(t) = 50 - 55 exp(-t / 500 s), which spans
+    -5 to 49.5 degC over the 2400-s log (recorded as block means of whole degrees, so within 1.5 degC);
+    the ``rest`` log is at a constant 25 degC: no warning, a span of 0."""
+    noise = tmp_path / "warm_noise.json"
+    code, out, err = invoke("noise", warm, "--units", "deg/s", "--json", noise)
+    assert code == 0, err
+    lines = [line for line in err.splitlines() if "thermal drift" in line]
+    assert len(lines) == 1 and lines[0].startswith("warning: the temperature rises by 5"), err
+    assert "let the board warm up before logging, or cut the log to its stable part" in lines[0]
+    temperature = json.loads(noise.read_text())["analysed"]["temperature"]
+    assert temperature["min"] == pytest.approx(-5.0, abs=1.5) and temperature["max"] == pytest.approx(49.5, abs=1.5)
+    assert temperature["span"] == pytest.approx(temperature["max"] - temperature["min"]) and temperature["unit"] == "degC"
+    assert load(noise, NoiseReport).warnings[-1] == lines[0].removeprefix("warning: ")
+    flat = tmp_path / "rest_noise.json"
+    code, out, err = invoke("noise", rest, "--units", "rad/s", "--json", flat)
+    assert code == 0 and "warning" not in err, err
+    assert json.loads(flat.read_text())["analysed"]["temperature"]["span"] == 0.0
+
+
 def _truth(rec) -> tuple[np.ndarray, float]:
     still = json.loads(rec.with_name(rec.stem + ".truth.json").read_text())["still"]["bias_tempco"]
     return np.array(still["coefs"]), still["ref_temp_degC"]

@@ -129,6 +129,53 @@ def test_verify_refuses_static_logs(bench, tmp_path):
     assert "no motion to align on" in refused(*_verify_args(tmp_path, "--ref-units", "deg/s"))
 
 
+def test_verify_names_the_reference_unit_or_its_short_span_not_the_motion(bench, tmp_path):
+    """Reference: the simulated pair's truth. The bench's reference written in rad/s but declared deg/s
+    is 57.3 times too small (the deg/rad factor), and its first third covers 33 % of the test log; the
+    refusals must name --ref-units rad/s and the short reference, not a repeating motion."""
+    folder, pair = bench
+    (tmp_path / "test.csv").write_text((folder / "test.csv").read_text())
+    save(Calibration(model=TRUE, input_units="deg/s", output_units="deg/s"), tmp_path / "cal.json")
+    write_recording(tmp_path / "ref.csv", pair.ref, units="rad/s")
+    line = refused(*_verify_args(tmp_path, "--ref-units", "deg/s", "--no-figures"))
+    assert "57." in line and "times smaller" in line and "give --ref-units rad/s" in line and "repeats" not in line
+    third = type(pair.ref)(t=pair.ref.t[:len(pair.ref.t) // 3], gyro=pair.ref.gyro[:len(pair.ref.t) // 3],
+                           sample_rate=100.0)
+    write_recording(tmp_path / "ref.csv", third, units="deg/s")
+    line = refused(*_verify_args(tmp_path, "--ref-units", "deg/s", "--no-figures"))
+    assert "the reference log covers only 33 % of the test log" in line and "repeats" not in line
+    assert not (tmp_path / "bad").exists()
+
+
+def test_a_rerun_replaces_the_whole_report_or_none_of_it(bench, tmp_path, monkeypatch):
+    """Reference: the list of files a run writes (``wrote ...``). After a run with figures, a run with
+    --no-figures leaves exactly verify.json and summary.md of gyrocal's names (a file of the user's
+    stays); a run that fails while drawing leaves the previous report byte for byte, and no temporary."""
+    import gyrocal.plotting.verify as drawing
+    from gyrocal.errors import InputError
+
+    folder, _ = bench
+    out = tmp_path / "out"
+    args = ("verify", folder / "cal.json", folder / "test.csv", "--reference", folder / "ref.csv", "--ref-units",
+            "deg/s", "-o", out, "--replicates", "50")
+    code, stdout, err = invoke(*args)
+    assert code == 0 and {p.name for p in out.iterdir()} == {"verify.json", "summary.md", "before.png", "after.png",
+                                                             "errors.png"}, err
+    (out / "mine.png").write_text("the user's own")
+    code, stdout, err = invoke(*args, "--no-figures", "--seed", "1")
+    assert code == 0 and f"wrote {out / 'verify.json'}, {out / 'summary.md'}\n" in stdout, err
+    assert sorted(p.name for p in out.iterdir()) == ["mine.png", "summary.md", "verify.json"]
+    assert invoke(*args)[0] == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+
+    def broken(*a, **k):
+        raise InputError("a figure that cannot be drawn")
+
+    monkeypatch.setattr(drawing, "error_figure", broken)
+    assert "a figure that cannot be drawn" in refused(*args, "--seed", "2")
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+
+
 def test_verify_needs_a_calibration_file(bench, tmp_path):
     folder, _ = bench
     save(SimulationTruth(protocol="servo", model=TRUE), tmp_path / "truth.json")

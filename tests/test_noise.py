@@ -8,6 +8,7 @@ width of the edf-based intervals (which allantools computes by Greenhall's algor
 
 import json
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -237,3 +238,60 @@ def test_allan_plot_draws_every_axis_in_the_chosen_unit(report):
     assert [len(art[k]) for k in ("adev", "density", "random_walk", "bias")] == [3, 3, 3, 3]
     np.testing.assert_allclose(art["adev"][0].get_ydata(), np.degrees(report.gyro.adev[0]))
     assert "deg/s" in ax.get_ylabel()
+
+
+def _warming(t, start=20.0, end=55.0, tau=200.0):
+    """First-order warm-up in closed form: T(t) = end - (end - start) exp(-t / tau)."""
+    return end - (end - start) * np.exp(-t / tau)
+
+
+def test_a_warming_board_warns_that_the_long_tau_figures_hold_the_drift(rng):
+    """Reference: the warm-up's closed form, whose range over the log is 20 to 55 - 35 exp(-3) = 53.26 degC
+    (the recorded range is of block means, within a block's rise of it), and a constant temperature, which
+    is no drift at all."""
+    fs, n = 50.0, 30_000
+    t = np.arange(n) / fs
+    g = rng.standard_normal((n, 3)) * 0.01
+    with pytest.warns(NoiseWarning, match=r"temperature rises by 3[0-3]\.\d degC .*include the bias's thermal "
+                                          r"drift: let the board warm up.*cut the log to its stable part"):
+        r = characterise(g, fs, temp=_warming(t) + rng.standard_normal(n) * 0.1)
+    assert r.temperature[0] == pytest.approx(20.0, abs=1.0) and r.temperature[1] == pytest.approx(53.26, abs=0.2)
+    assert "thermal drift" in r.warnings[-1]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", NoiseWarning)
+        flat = characterise(g, fs, temp=25.0 + np.round(rng.standard_normal(n) * 0.1, 2))
+    assert flat.temperature_span < 0.2 and flat.warnings == ()
+    assert characterise(g, fs).temperature is None
+
+
+def test_a_small_monotone_drift_warns_but_a_small_wander_does_not(rng):
+    """Reference: a straight 1-degC ramp (monotone: Spearman rho 1) against a 1-degC sine wander over
+    three periods (rho near 0), both under the 2-degC span threshold."""
+    fs, n = 50.0, 30_000
+    t = np.arange(n) / fs
+    g = rng.standard_normal((n, 3)) * 0.01
+    with pytest.warns(NoiseWarning, match=r"temperature falls by 1\.0 degC"):
+        characterise(g, fs, temp=30.0 - t / t[-1])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", NoiseWarning)
+        r = characterise(g, fs, temp=30.0 + 0.5 * np.sin(2 * np.pi * 3 * t / t[-1]))
+    assert r.temperature_span == pytest.approx(1.0, abs=0.05)
+
+
+def test_the_temperature_range_round_trips_and_older_version_2_files_load(report, tmp_path, rng):
+    """Reference: the range handed in; a version 2 file written before the field existed (no
+    ``analysed.temperature``) keeps loading, with no temperature."""
+    path = tmp_path / "noise.json"
+    r = characterise(rng.standard_normal((5000, 3)) * 0.01, 50.0, temp=np.full(5000, 31.5))
+    save_noise(path, r)
+    doc = json.loads(path.read_text())
+    assert doc["version"] == 2 and doc["analysed"]["temperature"] == {"min": 31.5, "max": 31.5, "span": 0.0,
+                                                                       "unit": "degC"}
+    assert load_noise(path).temperature == (31.5, 31.5)
+    del doc["analysed"]["temperature"]
+    path.write_text(json.dumps(doc))
+    assert load_noise(path).temperature is None
+    doc["analysed"]["temperature"] = {"min": 40.0, "max": 30.0}
+    path.write_text(json.dumps(doc))
+    with pytest.raises(FileFormatError, match="analysed.temperature' must hold numbers min <= max"):
+        load_noise(path)

@@ -139,6 +139,41 @@ def test_a_repeating_motion_is_refused_as_ambiguous(rng):
               motion(t_ref) + 0.001 * rng.standard_normal((6000, 3)))
 
 
+@pytest.mark.parametrize("factor, words", [
+    (math.pi / 180, r"57\.\d times smaller .* rad/s read as deg/s: give ref_units rad/s"),
+    (180 / math.pi, r"57\.\d times larger .* deg/s read as rad/s: give ref_units deg/s"),
+    (1 / 9.80665, r"9\.\d\d times smaller .* a factor of g: check ref_units"),
+])
+@pytest.mark.parametrize("motion", ["smooth", "servo"])
+def test_a_reference_in_the_wrong_unit_names_the_unit_not_the_motion(motion, factor, words):
+    """Reference: the unit factors themselves. The pair's reference, scaled by 180/pi (deg/s and rad/s
+    swapped) or g, is the same motion: its rate magnitudes differ from the test log's by that factor
+    only, which the error must name (with ``ref_units``) instead of an ambiguous or repeating motion."""
+    pair = make_pair(np.random.default_rng(21), motion=motion, offset=-2.3, drift=40.0, mounting_deg=12.0,
+                     noise_test=0.035, noise_ref=0.0005)
+    with pytest.raises(AlignmentError, match=words) as err:
+        align(pair.test.t, pair.test.gyro, pair.ref.t, pair.ref.gyro * factor)
+    assert err.value.param == "ref_units" and abs(math.log(err.value.value * factor)) < 0.02
+    a = align(pair.test.t, pair.test.gyro, pair.ref.t, pair.ref.gyro * 1.05)  # a calibration 5 % off is no unit
+    assert abs(a.time_offset_s + 2.3) < 4 * a.std[0]
+
+
+@pytest.mark.parametrize("share", [3, 2])
+def test_a_reference_covering_part_of_a_repeating_test_log_says_so(share):
+    """Reference: the simulated pair's truth. The servo method's turns repeat, so a reference cut to the first
+    1/3 (or 1/2) of a 56.8-s test log fits at the true offset, -2.3 s, and one turn further; both leave the
+    same share of the test log uncovered, which the error must say (the share it covers, 33 or 50 %), not
+    that the motion repeats."""
+    pair = make_pair(np.random.default_rng(21), motion="servo", offset=-2.3, drift=40.0, mounting_deg=12.0,
+                     noise_test=0.035, noise_ref=0.0005)
+    keep = len(pair.ref.t) // share
+    with pytest.raises(AlignmentError, match=rf"reference log covers only {100 // share} % of the test log "
+                                             r"\(\d+\.\d s of 56\.8 s\) at each offset that fits \(-2\.[23]\d\d s or "
+                                             r".*record the reference over the whole test log") as err:
+        align(pair.test.t, pair.test.gyro, pair.ref.t[:keep], pair.ref.gyro[:keep])
+    assert "repeats" not in str(err.value)
+
+
 def test_logs_of_different_motions_are_refused(rng):
     a = make_pair(np.random.default_rng(1), duration=40.0)
     b = make_pair(np.random.default_rng(2), duration=40.0)

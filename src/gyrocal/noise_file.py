@@ -6,7 +6,8 @@ Layout (SI units, recorded in ``units``; ``null`` for a figure not seen)::
       "format": "gyrocal.noise", "version": 2, "confidence": 0.6827,
       "units": {"gyroscope": {...}, "accelerometer": {...}, "time": "s"},
       "sample_rate": 200.0, "samples": 720000, "duration": 3600.0,
-      "analysed": {"start": 0.0, "stop": 3600.0, "log_duration": 3600.0, "motions_left_out": 0},
+      "analysed": {"start": 0.0, "stop": 3600.0, "log_duration": 3600.0, "motions_left_out": 0,
+                   "temperature": {"min": 24.9, "max": 25.1, "span": 0.2, "unit": "degC"} or null},
       "source": {"file": "static.csv", "gyro_units": "deg/s", "accel_units": "g"},
       "gyroscope": {
         "x": {"density": {"value": .., "low": .., "high": .., "tau": .., "edf": ..},
@@ -19,6 +20,8 @@ Layout (SI units, recorded in ``units``; ``null`` for a figure not seen)::
       "warnings": [...], "method": "...", "created_by": "gyrocal 0.2.0"
     }
 
+``analysed.temperature`` (the sensor temperature's range over the analysed stretch, null for a
+log without one) came after version 2 was first written: a version 2 file without it still loads.
 Version 1 files (gyro only, no intervals) are upgraded by :func:`upgrade_v1`, through
 :mod:`gyrocal.legacy`. The ``--noise-density`` argument of several commands accepts such a
 file (:func:`noise_density_arg`).
@@ -71,6 +74,24 @@ def _sensor_doc(s: SensorNoise, fs: float) -> dict:
     return doc
 
 
+def _temperature_doc(report: NoiseReport) -> dict | None:
+    if report.temperature is None:
+        return None
+    low, high = report.temperature
+    return {"min": low, "max": high, "span": high - low, "unit": "degC"}
+
+
+def _temperature_from(doc: dict, path) -> tuple[float, float] | None:
+    """The optional ``analysed.temperature`` (absent in the first version 2 files)."""
+    if (doc.get("analysed") or {}).get("temperature") is None:
+        return None
+    low, high = (_value(doc, f"analysed.temperature.{k}", path, positive=False) for k in ("min", "max"))
+    if not low <= high:
+        raise FileFormatError(f"{path}: field 'analysed.temperature' must hold numbers min <= max, got {low} and {high}",
+                              "analysed.temperature")
+    return low, high
+
+
 def to_document(report: NoiseReport) -> dict:
     """The JSON-ready document of `report`."""
     fs = report.sample_rate
@@ -79,7 +100,7 @@ def to_document(report: NoiseReport) -> dict:
         "units": {"gyroscope": UNITS["gyroscope"], "accelerometer": UNITS["accelerometer"], "time": "s"},
         "sample_rate": fs, "samples": report.samples, "duration": report.duration,
         "analysed": {"start": report.start, "stop": report.stop, "log_duration": report.log_duration,
-                     "motions_left_out": report.motions_left_out},
+                     "motions_left_out": report.motions_left_out, "temperature": _temperature_doc(report)},
         "source": dict(report.source),
         "gyroscope": _sensor_doc(report.gyro, fs),
         "accelerometer": None if report.accel is None else _sensor_doc(report.accel, fs),
@@ -131,7 +152,7 @@ def from_document(doc: dict, path="file") -> NoiseReport:
             log_duration=float(analysed.get("log_duration", math.nan)),
             motions_left_out=int(analysed.get("motions_left_out", 0)),
             confidence=_value(doc, "confidence", path, positive=True), source=dict(doc.get("source") or {}),
-            warnings=tuple(str(w) for w in doc.get("warnings") or ()))
+            warnings=tuple(str(w) for w in doc.get("warnings") or ()), temperature=_temperature_from(doc, path))
     except (InputError, TypeError, ValueError, AttributeError) as exc:
         raise FileFormatError(f"{path}: {exc}") from None
 

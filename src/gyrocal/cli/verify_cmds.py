@@ -27,6 +27,8 @@ __all__ = ["compare", "verify"]
 REF = ReadingFlags("ref-")
 #: Files ``verify`` writes into its folder (rewritten on every run).
 OUTPUTS = ("verify.json", "summary.md", "before.png", "after.png", "errors.png")
+#: Its figures: removed when a run does not draw them, so that none is left from an earlier run.
+FIGURES = OUTPUTS[2:]
 EXAMPLE_TEST = "example_servo_repeat.csv"  # tools/make_example.py: the testing period
 EXAMPLE_REFERENCE = "example_servo_reference.csv"
 
@@ -99,31 +101,37 @@ def _print_report(report) -> None:
 
 
 def _write_outputs(folder: Path, report, series, stretch, figures: bool) -> list[Path]:
-    from .._atomic import write_text_atomic
+    """Write the report's files into `folder`, all or none: each goes to a temporary beside its target
+    and every one moves into place only once all are written. Figures an earlier run left there and this
+    run does not draw (``--no-figures``, or no raw readings for before.png) are removed then, so the folder
+    never mixes two runs; only gyrocal's own figure names are touched."""
+    import contextlib
+
+    from .._atomic import atomic_path, write_text_atomic
     from ..files import save
     from ..verify.summary import summary_markdown
 
+    writers = {"verify.json": lambda path: save(report, path),
+               "summary.md": lambda path: write_text_atomic(path, summary_markdown(report))}
     if figures:  # a stretch outside the logs is refused before anything is written
-        from ..plotting.verify import check_stretch
+        from ..plotting import save_figure
+        from ..plotting.verify import check_stretch, error_figure, overlay_figure
 
         check_stretch(series.t, stretch)
-    folder.mkdir(parents=True, exist_ok=True)
-    written = [folder / "verify.json", folder / "summary.md"]
-    save(report, written[0])
-    write_text_atomic(written[1], summary_markdown(report))
-    if figures:
-        from ..plotting import save_figure
-        from ..plotting.verify import error_figure, overlay_figure
-
         pictures = {"before.png": lambda: overlay_figure(series, calibrated=False, stretch=stretch),
                     "after.png": lambda: overlay_figure(series, calibrated=True, stretch=stretch),
                     "errors.png": lambda: error_figure(series, stretch=stretch)}
         for name, draw in pictures.items():
-            if name == "before.png" and series.raw is None:
-                continue
-            save_figure(draw(), folder / name)
-            written.append(folder / name)
-    return written
+            if name != "before.png" or series.raw is not None:
+                writers[name] = lambda path, draw=draw: save_figure(draw(), path)
+    folder.mkdir(parents=True, exist_ok=True)
+    with contextlib.ExitStack() as stack:
+        for name, write in writers.items():
+            write(stack.enter_context(atomic_path(folder / name)))
+    for name in FIGURES:
+        if name not in writers:
+            (folder / name).unlink(missing_ok=True)
+    return [folder / name for name in writers]
 
 
 def _example(test: Path | None, reference: Path | None) -> tuple[Path, Path]:

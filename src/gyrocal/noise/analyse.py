@@ -28,6 +28,11 @@ __all__ = ["MotionPolicy", "NoiseWarning", "characterise", "characterise_recordi
 MIN_STILL_S = 10.0
 #: Fewer distinct readings than this on an axis: quantisation, not noise, shapes the short-tau curve.
 _FEW_LEVELS = 8
+#: A temperature span over the analysed stretch above this [degC] puts a thermal drift into the long-tau figures.
+TEMP_SPAN_WARN = 2.0
+#: A smaller span still warns when the drift is this large [degC] and clearly monotone (|Spearman rho| >= 0.9).
+TEMP_TREND_MIN = 0.5
+_TEMP_BLOCKS = 100
 
 
 class NoiseWarning(GyrocalWarning):
@@ -46,6 +51,27 @@ def _check_axes(name: str, x: np.ndarray, labels: tuple[str, ...], found: list[s
                          "short averaging times, so the density is that of the quantisation steps")
 
 
+def _temperature(temp, n: int, start: int, stop: int, found: list[str]) -> tuple[float, float] | None:
+    """Lowest and highest temperature [degC] over the analysed stretch (of block means, so that reading
+    noise does not count), with a warning in `found` when it drifts enough to reach the long-tau figures."""
+    if temp is None:
+        return None
+    t = finite_array("temp", temp, ndim=1)
+    if t.shape != (n,):
+        raise InputError(f"temp has {len(t)} samples but gyro has {n}")
+    means = np.array([b.mean() for b in np.array_split(t[start:stop], min(_TEMP_BLOCKS, stop - start))])
+    low, high = float(means.min()), float(means.max())
+    span = high - low
+    ranks = np.argsort(np.argsort(means, kind="stable"), kind="stable")
+    rho = np.corrcoef(ranks, np.arange(len(means)))[0, 1] if span > 0 else 0.0
+    if span > TEMP_SPAN_WARN or (span > TEMP_TREND_MIN and abs(rho) >= 0.9):
+        how = "rises" if means[-1] > means[0] else "falls"
+        found.append(f"the temperature {how} by {span:.1f} degC over the analysed stretch ({means[0]:.1f} to "
+                     f"{means[-1]:.1f} degC), so the long-tau figures (bias instability, random walk) include the "
+                     "bias's thermal drift: let the board warm up before logging, or cut the log to its stable part")
+    return low, high
+
+
 def _sensor(kind, x, fs, level) -> SensorNoise:
     taus, adev = allan_deviation(x, fs)
     curves, density, bias, walk, bound = read_figures(taus, adev, fs, len(x), level=level)
@@ -56,7 +82,7 @@ def _sensor(kind, x, fs, level) -> SensorNoise:
     return SensorNoise(kind, taus, curves, density, bias, walk, bound)
 
 
-def characterise(gyro, sample_rate: float, *, accel=None, motion: MotionPolicy = "restrict",
+def characterise(gyro, sample_rate: float, *, accel=None, temp=None, motion: MotionPolicy = "restrict",
                  level: float = ONE_SIGMA, source: dict | None = None) -> NoiseReport:
     """Allan deviation and noise figures, with intervals, of a log at rest.
 
@@ -68,6 +94,9 @@ def characterise(gyro, sample_rate: float, *, accel=None, motion: MotionPolicy =
         Sampling rate [Hz].
     accel : array_like, shape (N, 3), optional
         Accelerometer readings [m/s^2]; gravity is a constant and does not matter.
+    temp : array_like, shape (N,), optional
+        Sensor temperature [degC]: its range over the analysed stretch is recorded, and a drift
+        (over 2 degC, or over 0.5 degC and monotone) gives a :class:`NoiseWarning`.
     motion : {"restrict", "refuse"}
         What to do when the log moves: analyse its longest still stretch (with a
         :class:`NoiseWarning`), or raise.
@@ -107,13 +136,14 @@ def characterise(gyro, sample_rate: float, *, accel=None, motion: MotionPolicy =
                              f"still stretch, {(stop - start) / fs:.1f} s ({{param}} restrict)", param="motion")
         found.append(f"{what}: analysed the longest still stretch, {start / fs:.1f}-{stop / fs:.1f} s "
                      f"({(stop - start) / fs:.1f} s of {len(g) / fs:.1f} s)")
+    temperature = _temperature(temp, len(g), start, stop, found)
     for message in found:
         warnings.warn(message, NoiseWarning, stacklevel=2)
     gyro_noise = _sensor("gyroscope", g[start:stop], fs, level)
     accel_noise = None if a is None else _sensor("accelerometer", a[start:stop], fs, level)
     return NoiseReport(gyro_noise, accel_noise, fs, stop - start, start / fs, stop / fs, len(g) / fs,
                        motions_left_out=len(still.spans), confidence=level, source=dict(source or {}),
-                       warnings=tuple(found))
+                       warnings=tuple(found), temperature=temperature)
 
 
 def characterise_recording(rec: Recording, *, motion: MotionPolicy = "restrict", level: float = ONE_SIGMA,
@@ -132,4 +162,4 @@ def characterise_recording(rec: Recording, *, motion: MotionPolicy = "restrict",
     fs = rec.sample_rate
     if rec.has_time and len(rec) > 1:
         fs = (len(rec) - 1) / float(rec.t[-1] - rec.t[0])  # mean rate: bursty stamps average out
-    return characterise(rec.gyro, fs, accel=accel, motion=motion, level=level, source=info)
+    return characterise(rec.gyro, fs, accel=accel, temp=rec.temp, motion=motion, level=level, source=info)

@@ -97,6 +97,9 @@ class NoiseReport:
         Where the data came from (file name, declared units), for the record.
     warnings : tuple of str
         What the analysis warned about.
+    temperature : (float, float) or None
+        Lowest and highest sensor temperature over the analysed stretch [degC] (of block means),
+        None for a log without a temperature column.
     """
 
     gyro: SensorNoise
@@ -110,6 +113,7 @@ class NoiseReport:
     confidence: float = ONE_SIGMA
     source: dict = field(default_factory=dict)
     warnings: tuple[str, ...] = ()
+    temperature: tuple[float, float] | None = None
 
     FORMAT: ClassVar[str] = FORMAT
     VERSION: ClassVar[int] = VERSION
@@ -131,6 +135,11 @@ class NoiseReport:
     def duration(self) -> float:
         """Length of the analysed stretch [s]."""
         return self.samples / self.sample_rate
+
+    @property
+    def temperature_span(self) -> float | None:
+        """How far the temperature moved over the analysed stretch [degC]; None without a temperature."""
+        return None if self.temperature is None else self.temperature[1] - self.temperature[0]
 
     @property
     def density(self) -> np.ndarray:

@@ -42,6 +42,13 @@ AMBIGUITY = 1.25  # a second candidate within this factor of the best residual i
 MIN_OVERLAP_SAMPLES = 200
 MIN_EXPLAINED = 0.5  # share of the test log's rate energy the aligned reference must explain
 DRIFT_SEARCH_S = 180.0  # overlap from which the drift is first guessed segment by segment
+#: Unit mix-ups seen as the ratio of the test log's rate magnitude to the reference's, with what they mean.
+UNIT_RATIOS = ((180.0 / math.pi, "a reference in rad/s read as deg/s: give {param} rad/s"),
+               (math.pi / 180.0, "a reference in deg/s read as rad/s: give {param} deg/s"),
+               (9.80665, "a factor of g: check {param} and that the reference's columns are its gyro's"),
+               (1.0 / 9.80665, "a factor of g: check {param} and that the reference's columns are its gyro's"))
+UNIT_RATIO_TOLERANCE = 0.15  # relative distance of the magnitude ratio from a unit factor
+MIN_COVERAGE = 0.75  # an ambiguity where every fitting offset covers less of the test log is a short reference
 
 
 class AlignmentError(InputError):
@@ -193,6 +200,54 @@ def _candidate_score(t_test, w_test, t_ref, w_ref, offset: float) -> tuple[float
     return float(energy + np.sum(w_ref[~covered] ** 2) * dt_ref), r
 
 
+def _overlap(t_test, t_ref, offset: float) -> np.ndarray:
+    """Which test samples fall inside the reference log at `offset` (``t_test - t_ref``)."""
+    tau = t_test - offset
+    return (tau >= t_ref[0]) & (tau <= t_ref[-1])
+
+
+def _check_units(t_test, w_test, t_ref, w_ref, coarse) -> None:
+    """Refuse a reference whose rate magnitudes are a unit factor away from the test log's.
+
+    The magnitude correlation is normalised, so it finds the offset whatever the scale; the
+    candidates' residuals are then all about the test log's whole motion, which would read
+    as an ambiguous offset. The ratio of the RMS magnitudes over the overlap at the highest
+    correlation names the unit instead.
+    """
+    if coarse.peaks[0] < MIN_PEAK:
+        return
+    inside = _overlap(t_test, t_ref, coarse.offsets[0])
+    if inside.sum() < MIN_OVERLAP_SAMPLES:
+        return
+    v, _, _ = interpolate(t_ref, w_ref, t_test[inside] - coarse.offsets[0])
+    ratio = math.sqrt(float(np.sum(w_test[inside] ** 2)) / max(float(np.sum(v**2)), np.finfo(float).tiny))
+    for factor, meaning in UNIT_RATIOS:
+        if abs(ratio / factor - 1.0) < UNIT_RATIO_TOLERANCE:
+            size = f"{ratio:.3g} times smaller" if ratio > 1 else f"{1.0 / ratio:.3g} times larger"
+            raise AlignmentError(f"the reference's rates are {size} than the test log's over their overlap, so "
+                                 f"its unit is wrong, as with {meaning}", param="ref_units", value=ratio)
+
+
+def _ambiguous(t_test, t_ref, coarse, scored) -> AlignmentError:
+    """The error for two offsets that fit about equally: a reference covering only part of the
+    test log at each of them, or else a motion that repeats itself."""
+    fits = [float(coarse.offsets[i]) for score, i in scored if score < AMBIGUITY * scored[0][0]]
+    shown = " or ".join(f"{off:.3f} s" for off in fits[:2])
+    duration = t_test[-1] - t_test[0]
+    cover = []
+    for off in fits:
+        inside = t_test[_overlap(t_test, t_ref, off)]
+        cover.append((inside[-1] - inside[0]) / duration if len(inside) > 1 else 0.0)
+    if max(cover) < MIN_COVERAGE:
+        return AlignmentError(
+            f"the reference log covers only {100 * max(cover):.0f} % of the test log ({t_ref[-1] - t_ref[0]:.1f} s "
+            f"of {duration:.1f} s) at each offset that fits ({shown}), so the clock offset is ambiguous; record "
+            "the reference over the whole test log, or cut the test log to the part the reference covers")
+    return AlignmentError(
+        f"the motion repeats itself, so the clock offset is ambiguous ({shown} fit about equally); record a "
+        "motion that does not repeat (turns about different axes, different pauses)")
+
+
 def _best_candidate(t_test, w_test, t_ref, w_ref, coarse) -> tuple[float, np.ndarray, float]:
     scored = sorted((_candidate_score(t_test, w_test, t_ref, w_ref, off)[0], i) for i, off in enumerate(coarse.offsets))
     best_score, best = scored[0]
@@ -203,11 +258,7 @@ def _best_candidate(t_test, w_test, t_ref, w_ref, coarse) -> tuple[float, np.nda
             f"the rate magnitudes of the two logs do not match (best correlation {coarse.peaks[best]:.2f}); "
             "check that both logs record the same motion and overlap in time")
     if len(scored) > 1 and scored[1][0] < AMBIGUITY * best_score:
-        other = coarse.offsets[scored[1][1]]
-        raise AlignmentError(
-            f"the motion repeats itself, so the clock offset is ambiguous ({coarse.offsets[best]:.3f} s or "
-            f"{other:.3f} s fit about equally); record a motion that does not repeat (turns about "
-            "different axes, different pauses)")
+        raise _ambiguous(t_test, t_ref, coarse, scored)
     _, rot = _candidate_score(t_test, w_test, t_ref, w_ref, coarse.offsets[best])
     return float(coarse.offsets[best]), rot, float(coarse.peaks[best])
 
@@ -283,7 +334,9 @@ def align(t_test, w_test, t_ref, w_ref, *, fit_drift: bool = True) -> Alignment:
     Raises
     ------
     AlignmentError
-        Static logs, no overlap, turns about a single direction, a repeating motion.
+        Static logs, no overlap, turns about a single direction, a repeating motion, a
+        reference a unit factor (57.3, 9.81) away from the test log, or one that covers only
+        part of it where that leaves the offset ambiguous.
     """
     t_test, w_test, t_ref, w_ref = _check_inputs(t_test, w_test, t_ref, w_ref)
     noise_test = second_difference_noise(t_test, w_test).std
@@ -292,7 +345,9 @@ def align(t_test, w_test, t_ref, w_ref, *, fit_drift: bool = True) -> Alignment:
     grid = grid_rate_for(rate_test, rate_ref)
     _check_motion("test", t_test, w_test, noise_test, grid)
     _check_motion("reference", t_ref, w_ref, noise_ref, grid)
-    offset, rot, peak = _best_candidate(t_test, w_test, t_ref, w_ref, coarse_offsets(t_test, w_test, t_ref, w_ref, grid))
+    coarse = coarse_offsets(t_test, w_test, t_ref, w_ref, grid)
+    _check_units(t_test, w_test, t_ref, w_ref, coarse)
+    offset, rot, peak = _best_candidate(t_test, w_test, t_ref, w_ref, coarse)
     drift = 0.0
     if fit_drift:
         offset, drift = _initial_drift(t_test, w_test, t_ref, w_ref, offset, grid)
