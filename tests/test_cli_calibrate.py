@@ -427,3 +427,13 @@ def test_declared_reference_accuracy_flags(tmp_path):
     assert "--speed-sd must be a number >= 0" in refused("calibrate", "--example", "--speed-sd", "-1")
     assert "not --method lm" in refused("calibrate", "--example", "--speed-sd", "0.1", "--method", "lm")
     assert "for turn angles give --angle-sd" in refused("calibrate", "--example", "--angle", "360", "--speed-sd", "1")
+
+
+def test_a_windows_file_without_turns_is_told_to_add_them(tmp_path):
+    """A windows file of static windows only: the refusal points at the file, not at giving one."""
+    import json
+
+    assert invoke("simulate", "-o", tmp_path / "s.csv")[0] == 0
+    (tmp_path / "w.json").write_text(json.dumps([{"start": 0, "stop": 300, "kind": "static"}]))
+    line = refused("calibrate", tmp_path / "s.csv", "--units", "deg/s", "--windows", tmp_path / "w.json")
+    assert "add the missing rotation windows to the windows file (--windows)" in line

@@ -69,6 +69,11 @@ def test_thermal_then_report(files, tmp_path, capsys, monkeypatch):
     for name in ("summary.md", "summary.csv", "coefficients.png", "error_vs_rate.png", "error_vs_temperature.png"):
         assert (rep / name).stat().st_size > 0
     assert "lagrange" in capsys.readouterr().out
+    # again without figures: the first run's figures would not match the new tables, so they go; a user's file stays
+    (rep / "notes.txt").write_text("mine")
+    assert run(["thermal-report", str(out), str(files["test"]), "-o", str(rep), "--settle", "1",
+                "--full-scale", "300", "--no-figures"]) == 0
+    assert not list(rep.glob("*.png")) and (rep / "notes.txt").read_text() == "mine"
 
 
 def test_thermal_bad_session_is_one_line_exit_2(files, tmp_path, capsys):

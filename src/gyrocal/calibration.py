@@ -42,7 +42,7 @@ from .files import register
 from .models import KG_NAMES, Affine, CalibrationModel, ScaleBias
 from .recording import Recording
 from .sections import AccelerometerPart, FitQuality, Observed, section
-from .units import InputUnit, RateUnit, parse_input_unit, parse_rate_unit, unit_factor
+from .units import InputUnit, RateUnit, input_scale, parse_input_unit, parse_rate_unit, unit_factor
 
 __all__ = ["Calibration"]
 
@@ -128,10 +128,8 @@ class Calibration:
 
     @property
     def input_scale(self) -> float:
-        """Multiplier from input units to internal units."""
-        if self.input_units == "counts":
-            return 1.0 if self.sensitivity is None else unit_factor(self.output_units) / self.sensitivity
-        return unit_factor(self.input_units)
+        """Multiplier from input units to internal units (:func:`gyrocal.units.input_scale`)."""
+        return input_scale(self.input_units, self.sensitivity, self.output_units)
 
     @property
     def correction(self) -> tuple[np.ndarray, np.ndarray]:

@@ -35,7 +35,7 @@ from .screening import reference_variances, require_constant_rate, screen_gaps
 from .segmentation import Segmentation, segment, standstill_level
 from .timebase import TimeBase
 from .turn_angle import follow_wander
-from .units import parse_input_unit, parse_rate_unit, unit_factor
+from .units import input_scale, parse_input_unit, parse_rate_unit, unit_factor
 from .window_stats import observe_windows
 from .windows import Window
 
@@ -324,7 +324,7 @@ def calibrate(
                       declared=value if windows is None or reference == "speed" else math.nan,
                       sample_rate=rec.sample_rate, has_time=rec.has_time, sensitivity=rec.sensitivity,
                       counted=tb.counted)
-        scale = _input_scale(input_units, rec.sensitivity, out_units)
+        scale = input_scale(input_units, rec.sensitivity, out_units)
         fit, obs_set, quality, warnings, notes = check_fit(fit, obs_set, estimator, [_label(w) for w in used],
                                                            reference=reference, ctx=ctx, input_scale=scale)
         warnings[1 if quality.warnings else 0:0] = single_turn_warnings(
@@ -367,13 +367,6 @@ def _observed(rec: Recording, tb: TimeBase, noise_std, input_scale: float, input
             # the noise of the quiet stretches, measured as apply measures the data it corrects
             "quiet_noise_std": (quiet_noise(_spread_blocks(rec.gyro, rec.sample_rate), rec.sample_rate)
                                 / input_scale).tolist()}
-
-
-def _input_scale(input_units: str, sensitivity, output_units: str) -> float:
-    """Internal units per input unit (:attr:`gyrocal.calibration.Calibration.input_scale`)."""
-    if input_units == "counts":
-        return 1.0 if sensitivity is None else unit_factor(output_units) / sensitivity
-    return unit_factor(input_units)
 
 
 def _spread_blocks(gyro: np.ndarray, sample_rate: float, most: int = 200) -> np.ndarray:

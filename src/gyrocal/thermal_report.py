@@ -49,6 +49,10 @@ def _write_rows(path: Path, rows: list[dict]) -> None:
         write_csv(path, {k: np.array([r[k] for r in rows]) for k in rows[0]})
 
 
+#: The figures a report draws (removed from the folder by a report without figures).
+FIGURES = ("coefficients.png", "error_vs_rate.png", "error_vs_temperature.png")
+
+
 def write_report(cal: ThermalCalibration, evaluation: Evaluation, out_dir: str | os.PathLike, *,
                  units: str | None = None, figures: bool = True, truth=None) -> list[Path]:
     """Write the tables (and figures) of an evaluation into `out_dir`; returns the paths written."""
@@ -63,6 +67,8 @@ def write_report(cal: ThermalCalibration, evaluation: Evaluation, out_dir: str |
         if rows:
             _write_rows(out / name, rows)
             written.append(out / name)
+        else:  # an earlier report's table would no longer belong to this one
+            (out / name).unlink(missing_ok=True)
     rms_cols = ["rotating_axis", "gyro_axis"] + [f"{m}_rms" for m in METHODS] + ["lagrange_rms_reduction_pct"]
     mean_cols = ["rotating_axis", "gyro_axis"] + [f"{m}_mean" for m in METHODS]
     lo, hi = cal.range
@@ -82,6 +88,9 @@ def write_report(cal: ThermalCalibration, evaluation: Evaluation, out_dir: str |
     written.append(out / "summary.md")
     if figures:
         written += _figures(cal, evaluation, out, unit, truth)
+    else:
+        for name in FIGURES:  # an earlier run's figures would not match these tables
+            (out / name).unlink(missing_ok=True)
     return written
 
 

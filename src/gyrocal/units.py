@@ -14,7 +14,8 @@ import numpy as np
 from .choices import InputUnit, RateUnit
 from .errors import UnitError
 
-__all__ = ["RateUnit", "InputUnit", "RATE_UNITS", "parse_rate_unit", "parse_input_unit", "to_rad_s", "from_rad_s", "unit_factor"]
+__all__ = ["RateUnit", "InputUnit", "RATE_UNITS", "parse_rate_unit", "parse_input_unit", "to_rad_s", "from_rad_s", "unit_factor",
+           "input_scale"]
 
 
 RATE_UNITS: tuple[str, ...] = get_args(RateUnit)
@@ -58,3 +59,11 @@ def to_rad_s(values, unit: str) -> np.ndarray:
 def from_rad_s(values, unit: str) -> np.ndarray:
     """Convert rates from rad/s to `unit`."""
     return np.asarray(values, dtype=float) / unit_factor(unit)
+
+
+def input_scale(input_units: str, sensitivity: float | None, output_units: str) -> float:
+    """Internal units per input unit: rad/s per deg/s or rad/s; for counts, rad/s per count through the
+    sensitivity [LSB per output unit], or 1 (counts stay counts) without one."""
+    if input_units == "counts":
+        return 1.0 if sensitivity is None else unit_factor(output_units) / sensitivity
+    return unit_factor(input_units)

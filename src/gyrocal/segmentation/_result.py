@@ -108,7 +108,9 @@ class Segmentation:
         turns = measured_turns(self.ignored, self.units)
         advice = ("turns too short to hold a steady speed: calibrate with the angle reference ({param:angle} 360)"
                   if short else self.advice
-                  or "check {param:speed}/{param:angle} and {param:units}, or give the windows with {param:windows}")
+                  or ("add the missing rotation windows to the windows file ({param:windows})"
+                      if self.reference == "file" else
+                      "check {param:speed}/{param:angle} and {param:units}, or give the windows with {param:windows}"))
         raise SegmentationError(
             f"found {describe_found(self.windows, self.ignored)}: {'; '.join(need)}"
             + (f"; the turns left out measure {turns}" if turns else ""),
