@@ -77,6 +77,9 @@ def test_noise_refuses_what_it_cannot_analyse(tmp_path, rng):
     zeros = tmp_path / "zeros.csv"
     zeros.write_text("t,gx,gy,gz\n" + "".join(f"{i / 100},0,0,0\n" for i in range(2000)))
     assert "reads 0 in every sample" in refused("noise", zeros, "--units", "rad/s")
+    tiny = tmp_path / "tiny.csv"  # three rows: one line saying so, not quantisation warnings first
+    tiny.write_text("t,gx,gy,gz\n0,0.1,0.2,0.3\n0.01,0.2,0.1,0.3\n0.02,0.1,0.3,0.2\n")
+    assert "needs at least 100 samples at rest, got 3" in refused("noise", tiny, "--units", "rad/s")
     counts = tmp_path / "counts.csv"
     np.savetxt(counts, np.column_stack([np.arange(3000) / 100, np.round(rng.standard_normal((3000, 3)) * 20)]),
                delimiter=",", header="t,gx,gy,gz", comments="", fmt="%g")

@@ -118,6 +118,8 @@ def characterise(gyro, sample_rate: float, *, accel=None, temp=None, motion: Mot
     if motion not in values(MotionPolicy):
         raise InputError(f"{{param}}={motion!r} is not one of {', '.join(values(MotionPolicy))}", param="motion",
                          value=motion)
+    if len(g) < MIN_SAMPLES:  # before any warning about the few samples there are
+        raise InputError(f"a noise analysis needs at least {MIN_SAMPLES} samples at rest, got {len(g)}")
     found: list[str] = []
     _check_axes("gyro", g, ("x", "y", "z"), found)
     if a is not None:
