@@ -295,6 +295,19 @@ def test_bundled_example_is_what_the_tool_generates():
     assert _make_example_module().main(["--check"]) == 0
 
 
+def test_example_check_tolerates_last_bits_but_not_a_change():
+    """--check passes another BLAS kernel's last bits (seen: 3.0000000000000004 against 3.000000000000001,
+    and a printed last digit flipping) and fails a real change of a number, a text or a row."""
+    same = _make_example_module().same_numbers
+    assert same('{"deg": 3.0000000000000004}', '{"deg": 3.000000000000001}')
+    assert same("t,gx\n0.005,1.234567\n", "t,gx\n0.005,1.234568\n", fixed_point=True)
+    assert not same("t,gx\n0.005,1.234567\n", "t,gx\n0.005,1.234569\n", fixed_point=True)
+    assert not same('{"deg": 3.0}', '{"deg": 3.0001}')
+    assert not same('{"ramp_s": 0.3}', '{"ramp_s": 0.4}')
+    assert not same("t,gx\n", "t,gy\n")
+    assert not same("t,gx\n0.005,1.0\n", "t,gx\n0.005,1.0\n0.010,1.0\n")
+
+
 def test_example_uncertainty_matches_monte_carlo_within_20_percent(tmp_path):
     """The 1-sigma printed for the bundled example against the spread over 200 simulated sessions.
 

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from approx import assert_close_tree
 from cli_runner import invoke
 
 from gyrocal.calibration import Calibration
@@ -57,7 +58,9 @@ def test_v1_thermal_loads_with_its_numbers_unchanged():
     doc = tc.to_document()
     assert doc["version"] == 2 and doc["kg_order"] == old["kg_names"] and "kg_names" not in doc
     assert "seed" not in doc["interpolation"]["rule"]
-    assert doc["points"] == old["points"] and doc["smooth"] == old["smooth"] and doc["range"] == old["range"]
+    # the inverse matrices are recomputed on load: equal to a few ulps times their condition, not bit for bit
+    for key in ("points", "smooth", "range"):
+        assert_close_tree(doc[key], old[key], rtol=1e-13, path=key)
 
 
 def _csv(path: Path) -> tuple[list[str], np.ndarray, list[str]]:
