@@ -19,6 +19,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from .errors import FileFormatError, InputError
+from .units import STANDARD_GRAVITY
 
 __all__ = ["AccelerometerPart", "FitQuality", "Observed", "Section", "section"]
 
@@ -270,7 +271,7 @@ class AccelerometerPart(Section):
         if corr is None:
             return {}
         units = self.get("units") or {}
-        gravity = float(units.get("gravity") or 9.80665)
+        gravity = float(units.get("gravity") or STANDARD_GRAVITY)
         factor = {"m/s^2": 1.0, "g": gravity}
         u_in, u_out = units.get("input", "m/s^2"), units.get("output", "m/s^2")
         if u_out not in factor or (u_in not in factor and u_in != "counts"):

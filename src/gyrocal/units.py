@@ -19,6 +19,9 @@ __all__ = ["RateUnit", "InputUnit", "RATE_UNITS", "parse_rate_unit", "parse_inpu
 
 
 RATE_UNITS: tuple[str, ...] = get_args(RateUnit)
+STANDARD_GRAVITY = 9.80665  # m/s^2, the standard acceleration of gravity (3rd CGPM, 1901)
+MAD_TO_SIGMA = 1.482602218505602  # median absolute deviation -> sigma of a Gaussian: 1 / Phi^-1(3/4)
+
 _FACTOR_TO_RAD_S = {"rad/s": 1.0, "deg/s": math.pi / 180.0}
 _ALIASES = {
     "rad/s": "rad/s", "rad/sec": "rad/s", "rads": "rad/s", "rad": "rad/s", "radps": "rad/s",

@@ -18,6 +18,7 @@ from .._validation import positive
 from ..models import ScaleBias
 from ..recording import Recording
 from ..simulation import ServoProtocol, VirtualGyro, simulate_servo
+from ..units import STANDARD_GRAVITY
 from ..windows import Window
 
 __all__ = ["MPU6050_ACCEL_SENSITIVITY", "MPU6050_SENSITIVITY", "DeviceSession", "counts", "simulate_device_session"]
@@ -86,7 +87,7 @@ class DeviceSession:
     def turns(self) -> tuple[Window, ...]:
         return tuple(w for w in self.windows if w.kind == "rotation")
 
-    def recording(self, start: int = 0, stop: int | None = None, gravity: float = 9.80665) -> Recording:
+    def recording(self, start: int = 0, stop: int | None = None, gravity: float = STANDARD_GRAVITY) -> Recording:
         """Samples ``start:stop`` as ``gyrocal capture`` reads them: counts at the session's sensitivities, in
         rad/s and m/s^2, the time from the first sample of the session [s]."""
         part = slice(start, len(self) if stop is None else stop)

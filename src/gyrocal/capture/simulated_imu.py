@@ -27,6 +27,7 @@ from ..simulation.multiposition import (
     random_accelerometer,
     simulate_multi_position,
 )
+from ..units import STANDARD_GRAVITY
 from ..windows import Window
 from .simulated import MPU6050_ACCEL_SENSITIVITY, MPU6050_SENSITIVITY, DeviceSession, _temperature, counts
 
@@ -34,7 +35,7 @@ __all__ = ["orientation_up", "simulate_device_imu_session", "z_scores"]
 
 #: MPU-6050 noise densities: gyro 0.005 deg/s/sqrt(Hz), accelerometer 400 ug/sqrt(Hz).
 GYRO_DENSITY = math.radians(0.005)
-ACCEL_DENSITY = 400e-6 * 9.80665
+ACCEL_DENSITY = 400e-6 * STANDARD_GRAVITY
 
 
 def orientation_up(up, heading: float = 0.0) -> np.ndarray:

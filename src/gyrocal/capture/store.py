@@ -19,7 +19,7 @@ import numpy as np
 
 from ..io.incremental import IncrementalCSV
 from ..recording import Recording
-from ..units import unit_factor
+from ..units import STANDARD_GRAVITY, unit_factor
 
 __all__ = ["RETAIN_N", "RETAIN_S", "SampleStore"]
 
@@ -190,7 +190,7 @@ class SampleStore:
 
     def recording(self, units: str, sensitivity: float | None, sample_rate: float | None = None, *,
                   start: int | None = None, accel_sensitivity: float | None = None,
-                  gravity: float = 9.80665) -> Recording:
+                  gravity: float = STANDARD_GRAVITY) -> Recording:
         """Samples from absolute index `start` (default: all in memory) as a :class:`Recording`: rad/s when
         the unit or sensitivity allows, the accelerometer in m/s^2 with a sensitivity, else in counts."""
         i = 0 if start is None else max(0, start - self.first)

@@ -29,6 +29,7 @@ import numpy as np
 from .._validation import at_least, finite_array, positive
 from ..errors import GyrocalWarning, InputError
 from ..stillness import find_motion
+from ..units import MAD_TO_SIGMA
 from .polyfit import ar1_covariance, choose_orders, segment_cv, vander
 from .temperature import temperature_course
 
@@ -230,7 +231,7 @@ def fit_thermal_bias(gyro, temp, sample_rate: float, *, max_order: int = MAX_ORD
     cv[: max_order + 1] = segment_cv(u, gm, seg, int(max_order))
     orders = choose_orders(cv[: max_order + 1], len(np.unique(seg)))
     d = np.diff(g[: len(g) // size * size].reshape(-1, size, 3), axis=1).reshape(-1, 3)
-    noise = 1.4826 * np.median(np.abs(d - np.median(d, axis=0)), axis=0) / math.sqrt(2.0)  # white, robust to drift
+    noise = MAD_TO_SIGMA * np.median(np.abs(d - np.median(d, axis=0)), axis=0) / math.sqrt(2.0)  # white, robust to drift
     coefs, cov, resid_rms, wander = _fit_axes(u, gm, orders, noise**2 / size, half)
     found = _quality(resid_rms, noise, size, cv, orders)
     for message in found:

@@ -30,6 +30,7 @@ from scipy.optimize import least_squares
 
 from .._validation import finite_array, positive
 from ..errors import DegenerateDesignError, InputError
+from ..units import STANDARD_GRAVITY
 from . import _fit
 from .poses import coverage, triangular_frame
 
@@ -289,7 +290,7 @@ def _fit_one(model, u, se, gravity, directions):
     return a, o, r, jac, d_u, rank
 
 
-def fit_accelerometer(means, se, *, gravity: float = 9.80665, model: AccelModel | Literal["auto"] = "auto",
+def fit_accelerometer(means, se, *, gravity: float = STANDARD_GRAVITY, model: AccelModel | Literal["auto"] = "auto",
                       directions=None) -> AccelFit:
     """Fit the accelerometer to still poses.
 

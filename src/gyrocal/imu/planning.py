@@ -19,6 +19,7 @@ import numpy as np
 from .. import quaternion as quat
 from .._validation import positive
 from ..errors import DegenerateDesignError, InputError
+from ..units import STANDARD_GRAVITY
 from . import _fit
 from ._gyro_cov import noise_model, whitener
 from ._gyro_problem import build_problem
@@ -140,7 +141,7 @@ def _crb(t, w, f, spans, gyro_se, accel_se, gravity) -> tuple[np.ndarray, np.nda
 
 def predict_poses(poses: int = 24, turn_deg: float = 90.0, *, static_duration: float = 2.0,
                   peak_rate_deg: float = 150.0, sample_rate: float = 100.0, accel_noise_density: float = 2e-3,
-                  gyro_noise_density: float = 1e-4, gravity: float = 9.80665) -> PosePlan:
+                  gyro_noise_density: float = 1e-4, gravity: float = STANDARD_GRAVITY) -> PosePlan:
     """Cramér–Rao accuracy of a plan.
 
     Parameters

@@ -21,7 +21,7 @@ from ..models import KG_INDEX, Affine, ScaleBias
 from ..observed import observe
 from ..recording import Recording
 from ..timebase import TimeBase
-from ..units import parse_rate_unit
+from ..units import STANDARD_GRAVITY, parse_rate_unit
 from .filedoc import accelerometer_section, gyro_fit_section
 from .session import ImuCalibrationResult, calibrate_imu
 
@@ -74,7 +74,7 @@ def plausibility(cal: Calibration) -> tuple[str, ...]:
         k = np.abs(np.diag(np.asarray(part["parameters"]["matrix"], dtype=float)))  # m/s^2 per m/s^2 as read
         if np.any(np.abs(k - 1) > SCALE_PLAUSIBLE):
             out.append(f"the accelerometer's scale factors are {', '.join(f'{v:.4g}' for v in k)}, far from 1: is "
-                       f"--accel-units {units['input']} right?{_unit_hint(k, 9.80665, 'g', 'm/s^2')}")
+                       f"--accel-units {units['input']} right?{_unit_hint(k, STANDARD_GRAVITY, 'g', 'm/s^2')}")
     return tuple(out)
 
 
@@ -96,7 +96,7 @@ def accel_scale(units: str, sensitivity: float | None, gravity: float) -> float:
     return {"m/s^2": 1.0, "g": gravity}[units]
 
 
-def calibrate_recording(rec: Recording, *, windows=None, gravity: float = 9.80665, accel_model="auto",
+def calibrate_recording(rec: Recording, *, windows=None, gravity: float = STANDARD_GRAVITY, accel_model="auto",
                         gyro_model="auto", g_sensitivity: bool = False, min_static: float = 1.0,
                         output_units: str | None = None, accel_output_units: str = "m/s^2") -> ImuRun:
     """Calibrate the gyro and the accelerometer of a hand session.

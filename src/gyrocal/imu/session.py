@@ -24,6 +24,7 @@ import numpy as np
 
 from .._validation import at_least, finite_array, positive
 from ..errors import InputError, SegmentationError
+from ..units import STANDARD_GRAVITY
 from ..windows import Window
 from ._fit import unchecked_warning
 from .accel import AccelFit, fit_accelerometer
@@ -139,7 +140,7 @@ def _pairs_without_gaps(statics, gaps) -> tuple[np.ndarray, list[tuple[int, int]
     return np.array(keep, dtype=int).reshape(-1, 2), lost
 
 
-def calibrate_imu(t, gyro, accel, *, gravity: float = 9.80665, windows: Sequence[Window] | None = None,
+def calibrate_imu(t, gyro, accel, *, gravity: float = STANDARD_GRAVITY, windows: Sequence[Window] | None = None,
                   accel_model="auto", gyro_model="auto", g_sensitivity: bool = False,
                   min_static: float = 1.0, gaps: Sequence[int] = ()) -> ImuCalibrationResult:
     """Calibrate the accelerometer and the gyro of a hand session.

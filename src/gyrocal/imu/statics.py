@@ -29,6 +29,7 @@ from scipy import stats
 
 from .._validation import finite_array, positive
 from ..errors import InputError
+from ..units import MAD_TO_SIGMA
 
 __all__ = ["Static", "StaticDetection", "detect_statics", "long_run_ratio", "summarise_statics"]
 
@@ -146,7 +147,7 @@ def _noise_and_threshold(var: np.ndarray, floor_var: np.ndarray) -> tuple[np.nda
     stat = (var / noise).sum(axis=1)
     q = stat[quiet]
     med = float(np.median(q))
-    spread = 1.4826 * float(np.median(np.abs(q - med))) / max(med, 1e-300)
+    spread = MAD_TO_SIGMA * float(np.median(np.abs(q - med))) / max(med, 1e-300)
     dof = float(np.clip(2.0 / max(spread, 1e-3) ** 2, 1.0, 1e6))
     threshold = med * float(stats.chi2.ppf(1.0 - _FALSE_MOTION, dof)) / dof
     return noise, stat, threshold
@@ -162,7 +163,7 @@ def _near_still_level(mean_g: np.ndarray, quiet: np.ndarray) -> np.ndarray:
         return quiet
     q = mean_g[quiet]
     level = np.median(q, axis=0)
-    spread = 1.4826 * np.median(np.abs(q - level), axis=0)
+    spread = MAD_TO_SIGMA * np.median(np.abs(q - level), axis=0)
     spread = np.maximum(spread, 1e-9 * max(float(np.abs(q).max()), np.finfo(float).tiny))
     return np.all(np.abs(mean_g - level) <= 6.0 * spread, axis=1)
 

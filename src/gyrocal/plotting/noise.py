@@ -6,13 +6,14 @@ import math
 
 import numpy as np
 
+from ..units import STANDARD_GRAVITY
 from .figure import new_figure, outside_legend
 
 __all__ = ["allan_deviation_plot", "allan_figure"]
 
 #: Factor from internal units to a displayed unit, and its label.
 _DISPLAY = {"rad/s": (1.0, "rad/s"), "deg/s": (180.0 / math.pi, "deg/s"), "m/s^2": (1.0, "m/s^2"),
-            "g": (1.0 / 9.80665, "g")}
+            "g": (1.0 / STANDARD_GRAVITY, "g")}
 
 
 def allan_deviation_plot(ax, sensor, *, axes: str = "xyz", unit: str | None = None) -> dict:

@@ -24,6 +24,7 @@ from .._validation import finite_array, positive
 from ..errors import InputError
 from ..imu import poses as _poses
 from ..imu.gyro import EARTH_RATE
+from ..units import STANDARD_GRAVITY
 from .gyro import VirtualGyro
 
 __all__ = ["ImuSession", "MultiPositionProtocol", "VirtualImu", "hand_session", "mounted_gyro", "random_accelerometer",
@@ -120,7 +121,7 @@ class MultiPositionProtocol:
     lever_arm: tuple[float, float, float] = (0.03, -0.02, 0.01)
     sample_rate: float = 100.0
     uneven_steps: float = 0.0
-    gravity: float = 9.80665
+    gravity: float = STANDARD_GRAVITY
     latitude_deg: float | None = 45.0
 
     def __post_init__(self):

@@ -18,12 +18,10 @@ import numpy as np
 from .._validation import at_least, finite_array, positive, temperature
 from ..errors import InputError
 from ..recording import Recording
+from ..units import STANDARD_GRAVITY
 from .gyro import VirtualGyro
 
 __all__ = ["BiasDrift", "StillAccelerometer", "StillProtocol", "simulate_still"]
-
-#: Standard gravity [m/s^2], along +z of a board lying flat.
-GRAVITY = 9.80665
 
 
 @dataclass(frozen=True)
@@ -123,7 +121,7 @@ class StillAccelerometer:
     def measure(self, n: int, sample_rate: float, rng: np.random.Generator) -> np.ndarray:
         """Readings (n, 3) [m/s^2]."""
         a = np.zeros((n, 3))
-        a[:, 2] = GRAVITY
+        a[:, 2] = STANDARD_GRAVITY
         a += rng.standard_normal((n, 3)) * self.noise_density * math.sqrt(sample_rate)
         if self.random_walk > 0:
             a += np.cumsum(rng.standard_normal((n, 3)) * self.random_walk / math.sqrt(sample_rate), axis=0)

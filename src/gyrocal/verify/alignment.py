@@ -28,6 +28,7 @@ from scipy.spatial.transform import Rotation
 
 from .._validation import finite_array
 from ..errors import InputError
+from ..units import STANDARD_GRAVITY
 from .coarse import coarse_offsets, grid_rate_for, magnitude_grid, segment_drift
 from .refine import PPM, interpolate, refine
 from .whitenoise import second_difference_noise
@@ -45,8 +46,8 @@ DRIFT_SEARCH_S = 180.0  # overlap from which the drift is first guessed segment 
 #: Unit mix-ups seen as the ratio of the test log's rate magnitude to the reference's, with what they mean.
 UNIT_RATIOS = ((180.0 / math.pi, "a reference in rad/s read as deg/s: give {param} rad/s"),
                (math.pi / 180.0, "a reference in deg/s read as rad/s: give {param} deg/s"),
-               (9.80665, "a factor of g: check {param} and that the reference's columns are its gyro's"),
-               (1.0 / 9.80665, "a factor of g: check {param} and that the reference's columns are its gyro's"))
+               (STANDARD_GRAVITY, "a factor of g: check {param} and that the reference's columns are its gyro's"),
+               (1.0 / STANDARD_GRAVITY, "a factor of g: check {param} and that the reference's columns are its gyro's"))
 UNIT_RATIO_TOLERANCE = 0.15  # relative distance of the magnitude ratio from a unit factor
 MIN_COVERAGE = 0.75  # an ambiguity where every fitting offset covers less of the test log is a short reference
 

@@ -16,9 +16,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..units import MAD_TO_SIGMA
+
 __all__ = ["NoiseEstimate", "second_difference_noise"]
 
-_MAD_TO_SIGMA = 1.482602218505602  # 1 / Phi^-1(3/4), Gaussian
 # n var(s_hat) / s^2 of the MAD scale of second differences on an even grid: 1.977. Neighbouring
 # differences share samples (correlations -2/3 and 1/6); the figure is the asymptotic variance of
 # a median, sum over lags of cov(1{|d_0| < q}, 1{|d_k| < q}) / (q * density of |d| at q)^2, with
@@ -59,5 +60,5 @@ def second_difference_noise(t: np.ndarray, w: np.ndarray) -> NoiseEstimate:
     h1, h2 = t[1:-1] - t[:-2], t[2:] - t[1:-1]
     lam = (h2 / (h1 + h2))[:, None]  # weight of the previous sample in the straight line
     d = (w[1:-1] - lam * w[:-2] - (1.0 - lam) * w[2:]) / np.sqrt(1.0 + lam**2 + (1.0 - lam) ** 2)
-    std = _MAD_TO_SIGMA * np.median(np.abs(d - np.median(d, axis=0)), axis=0)
+    std = MAD_TO_SIGMA * np.median(np.abs(d - np.median(d, axis=0)), axis=0)
     return NoiseEstimate(std=std, std_err=std * np.sqrt(_MAD_VARIANCE / len(d)), rms=np.sqrt(np.mean(d * d, axis=0)))
