@@ -42,7 +42,7 @@ def test_time_not_in_seconds_under_a_plain_name_is_refused(tmp_path, rng, name, 
     stamps = (1000.0 + np.arange(50) * 0.005) * per_s  # 200 Hz, stamped from boot
     write_csv(tmp_path / "r.csv", table(name, stamps, g))
     msg = bad(tmp_path / "r.csv", re.escape(f"nominal time step is {step}, "))
-    assert "Hz if the times are seconds" in msg and "rename it e.g. time_ms, time_us or time_ns" in msg
+    assert "Hz if the times are seconds" in msg and "time_units ms, us or ns" in msg and "(e.g. time_ms)" in msg
     # the advice works: the unit in the column's name scales the stamps to seconds
     unit = {1e3: "ms", 1e6: "us", 1e9: "ns"}[per_s]
     write_csv(tmp_path / "ok.csv", table(f"time_{unit}", stamps, g))

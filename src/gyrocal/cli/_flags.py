@@ -15,6 +15,8 @@ FLAGS: dict[str, str] = {
     "units": "--units",
     "columns": "--columns",
     "skip_rows": "--skip-rows",
+    "time_units": "--time-units",
+    "nan": "--nan",
     # plan
     "target_scale": "--target-scale",
     "target_bias": "--target-bias",

@@ -54,6 +54,13 @@ class ReadingFlags:
             metavar="<rad/s|deg/s>")]
         self.Topic = Annotated[Optional[str], opt(
             "topic", "sensor_msgs/Imu topic in a ROS 1/ROS 2/MCAP bag (default: the only one).")]
+        self.TimeUnits = Annotated[Optional[str], opt(
+            "time-units", "Unit of a time column whose name carries none (default: s; with --sample-rate, steps of "
+            "~1000 or ~1e6 periods are read as ms or us, with a note).", metavar="<s|ms|us|ns>")]
+        self.Nan = Annotated[str, opt(
+            "nan", "Rows with NaN, inf or empty cells in the columns used: 'error' refuses, 'drop' removes them "
+            "(counted in a note; they leave a gap in the time stamps, or in the row numbers used as time with "
+            "--sample-rate).", metavar="<error|drop>")]
         self.Saturation = Annotated[SaturationPolicy, opt(
             "saturation", "Samples stuck at full scale: refuse (error), drop them, or ignore.")]
         self.NoUnitCheck = Annotated[bool, opt(
@@ -99,15 +106,24 @@ def read_from_flags(
     gravity: float = STANDARD_GRAVITY,
     need_accel: bool = False,
     imu: int | None = None,
+    time_units: str | None = None,
+    nan: str = "error",
+    notes: list | None = None,
 ):
     """A :class:`~gyrocal.recording.Recording` from the reading flags (see :func:`gyrocal.io.read_recording`)."""
     from ..io import read_recording
+    from .app import console
 
-    return read_recording(path, units=units, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
+    notes = [] if notes is None else notes
+    rec = read_recording(path, units=units, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
                           sensitivity=sensitivity,
                           output_units=output_units, topic=topic, check_units=not no_unit_check,
                           saturation=saturation, accel_units=accel_units, accel_sensitivity=accel_sensitivity,
-                          gravity=gravity, need_accel=need_accel, imu=imu)
+                          gravity=gravity, need_accel=need_accel, imu=imu, time_units=time_units,
+                         nan=nan, notes=notes)
+    for note in notes:
+        console.print(f"note: {note}", highlight=False, soft_wrap=True, markup=False)
+    return rec
 
 
 @contextlib.contextmanager

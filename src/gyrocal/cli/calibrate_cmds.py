@@ -175,6 +175,8 @@ def calibrate(
     saturation: READING.Saturation = "error",
     no_unit_check: READING.NoUnitCheck = False,
     imu: READING.Imu = None,
+    time_units: READING.TimeUnits = None,
+    nan: READING.Nan = "error",
     speed: Speed = None,
     angle: Angle = None,
     angle_sd: AngleSd = None,
@@ -209,7 +211,7 @@ def calibrate(
                  + (f"--speed {speed:g}" if speed is not None else f"--angle {360 if angle is None else angle:g}"))
     if recording is None:
         raise InputError("give a recording to calibrate (or --example for the bundled one)")
-    units = required_units(units)
+    units, read_notes = required_units(units), []
     rate_unit = rate_unit_of(units, output_units)
     reference, speed_rad, angle_rad, ref_sd = reference_of(speed, angle, rate_unit, speed_sd=speed_sd,
                                                            angle_sd=angle_sd)
@@ -217,14 +219,14 @@ def calibrate(
         raise InputError(f"--{reference}-sd applies to the default method (first-moment), not --method {method}")
     rec = read_from_flags(recording, units=units, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
                           sensitivity=sensitivity, output_units=output_units, topic=topic, saturation=saturation,
-                          no_unit_check=no_unit_check, imu=imu)
+                          no_unit_check=no_unit_check, imu=imu, time_units=time_units, nan=nan, notes=read_notes)
     win = _windows_from_file(windows, rec)
     noise = noise_to_internal(noise_std, units, rate_unit, sensitivity)
     if noise_density is not None:
         noise = density_to_internal(noise_density, noise_std, rec)
     run = run_calibration(rec, speed=speed_rad, angle=angle_rad, method=method, windows=win, noise_std=noise,
                           output_units=rate_unit, reference_sd=ref_sd)
-    cal = run.calibration
+    cal = _with_notes(run.calibration, read_notes)
     doc = cal.to_document()
     inputs = (Path(recording), windows)
     check_output(output, inputs=inputs, force=force, replaceable=same_document(doc),
@@ -245,6 +247,15 @@ def calibrate(
     _print_calibration(run, None if truth_path is None else _truth_calibration(truth_path, cal))
     if output is not None:
         console.print(f"wrote {output}" + (f" and {plot}" if plot is not None else ""), highlight=False)
+
+
+def _with_notes(cal, notes: list):
+    """The calibration with the reading's notes (rows dropped, ms stamps recognised) first in its fit's notes."""
+    import dataclasses
+
+    if not notes or cal.fit is None:
+        return cal
+    return dataclasses.replace(cal, fit={**cal.fit, "notes": list(notes) + list(cal.fit.get("notes", []))})
 
 
 def _save_plot(path: Path, rec, windows, cal, speed_rad, title: str) -> None:

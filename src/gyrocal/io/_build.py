@@ -14,6 +14,7 @@ from ..saturation import find_saturation, stuck_runs
 from ..timebase import nominal_period
 from ..units import parse_input_unit, parse_rate_unit, unit_factor
 from ._columns import ACCEL, NUMERIC
+from ._rows import drop_nan_rows, time_in_seconds
 
 #: No MEMS gyro measures beyond about 2000 deg/s (4000 for a few); above this, rad/s is a unit mistake.
 MAX_PLAUSIBLE_RAD_S = math.radians(2000.0)
@@ -45,7 +46,7 @@ def _check_finite(data: dict, source: str, known_finite: tuple[str, ...] = ()) -
     cols = [c for c in NUMERIC if c in data and not np.isfinite(data[c][first])]
     raise NonFiniteInputError(
         f"{source}: {int(bad.sum())} row(s) hold NaN, inf or empty cells, first at data row {first + 1} "
-        f"(column {', '.join(cols)}); remove or fill those rows first"
+        f"(column {', '.join(cols)}); remove or fill those rows first, or drop them ({{param}} drop)", param="nan"
     )
 
 
@@ -74,8 +75,8 @@ def _check_time(t: np.ndarray, source: str) -> float:
     if not MIN_SAMPLE_RATE * (1 - 1e-6) <= fs <= MAX_SAMPLE_RATE * (1 + 1e-6):
         raise InputError(
             f"{source}: the nominal time step is {step:.6g}, {fs:.3g} Hz if the times are seconds, "
-            "outside the 0.5 Hz-100 kHz of a gyro; times in ms, us or ns need the unit in the column's name: "
-            "rename it e.g. time_ms, time_us or time_ns"
+            "outside the 0.5 Hz-100 kHz of a gyro; times in ms, us or ns need {param} ms, us or ns, or the unit "
+            "in the column's name (e.g. time_ms)", param="time_units"
         )
     return fs
 
@@ -245,10 +246,14 @@ def build_recording(
     accel_units: str | None = None,
     accel_sensitivity: float | None = None,
     gravity: float = STANDARD_GRAVITY,
+    time_units: str | None = None,
+    nan: str = "error",
+    notes: list | None = None,
 ) -> Recording:
     """Check parsed columns and convert them to a :class:`Recording` (see :func:`gyrocal.io.read_recording`)."""
     accel = _accel_fields(data, source, accel_units, accel_sensitivity, gravity)
     unit, out_unit, sensitivity, sample_rate = _reading_options(units, output_units, sensitivity, sample_rate)
+    data, extra, rows = drop_nan_rows(data, extra, nan, source, [] if notes is None else notes)
     n = len(data["gx"])
     if n < 2:
         raise InputError(f"{source}: {'no data rows' if n == 0 else 'a single data row'}; a recording needs at least two samples")
@@ -263,10 +268,12 @@ def build_recording(
                          hint="map the gyro's columns with {param} gx=NAME,gy=NAME,gz=NAME")
     if "t" in data:
         t, has_time = np.asarray(data["t"], dtype=float), True  # a time column wins over sample_rate
+        t = time_in_seconds(t, time_units, sample_rate, source, [] if notes is None else notes)
         fs = _check_time(t, source)
     elif sample_rate is not None:
         fs = sample_rate
-        t, has_time = np.arange(n) / fs, False
+        # rows dropped for NaN keep their row numbers: a gap in the time base, not samples glued together
+        t, has_time = (np.arange(n) if rows is None else rows.astype(float)) / fs, False
     else:
         raise InputError(
             f"{source}: no time column (t, time, timestamp, ...)", param="sample_rate",

@@ -75,6 +75,9 @@ def read_recording(
     gravity: float = STANDARD_GRAVITY,
     need_accel: bool = False,
     imu: int | None = None,
+    time_units: str | None = None,
+    nan: str = "error",
+    notes: list | None = None,
 ) -> Recording:
     """Read a gyro recording from a file and check it.
 
@@ -130,6 +133,14 @@ def read_recording(
     imu : int, optional
         For a PX4 ULog or ArduPilot DataFlash log (:func:`gyrocal.io.read_flight_log`): which
         IMU instance, needed when the log holds several.
+    time_units : {"s", "ms", "us", "ns"}, optional
+        Unit of the time column. Default: seconds, except that with `sample_rate` given, steps of
+        about 1000 or 1e6 declared periods are read as ms or us (with a line in `notes`).
+    nan : {"error", "drop"}
+        Rows with NaN, inf or empty cells in the columns used: refuse (default) or drop them; dropped
+        rows leave a gap in the time stamps (or, without a time column, in the row numbers used as time).
+    notes : list, optional
+        Receives one line per thing done that the data did not say (ms stamps recognised, rows dropped).
 
     Returns
     -------
@@ -197,6 +208,9 @@ def read_recording(
         accel_units=accel_units,
         accel_sensitivity=accel_sensitivity,
         gravity=gravity,
+        time_units=time_units,
+        nan=nan,
+        notes=notes,
     )
 
 
