@@ -15,10 +15,13 @@ import pytest
 
 from gyrocal.errors import FileFormatError, InputError, UnitError
 from gyrocal.models import ScaleBias
-from gyrocal.noise import BI_FACTOR, NoiseWarning, characterise, characterise_recording
+from gyrocal.noise import NoiseWarning, characterise, characterise_recording
 from gyrocal.noise_file import load_noise, noise_density_arg, save_noise
 from gyrocal.recording import Recording
 from gyrocal.simulation import VirtualGyro
+
+# IEEE Std 952-1997, Annex C: a flicker floor of the Allan deviation sits at sqrt(2 ln 2 / pi) B = 0.6643 B
+FLICKER_FLOOR = math.sqrt(2 * math.log(2) / math.pi)
 
 FS, HOURS = 100.0, 3.0
 SIGMA, BI_STD, BI_TAU, RRW = 0.01, 2e-4, 100.0, 2e-5
@@ -67,7 +70,7 @@ def test_density_is_the_white_noise_and_inside_its_interval(report):
 
 def test_bias_instability_is_the_floor_over_0664(report):
     theory = np.sqrt(_avar_theory(report.gyro.taus))
-    floor = theory.min() / BI_FACTOR
+    floor = theory.min() / FLICKER_FLOOR
     b = report.gyro.bias_instability
     tol = 4 * _rel_sd(b.tau[:3])
     assert np.all(np.abs(b.value[:3] / floor - 1) < tol), (b.value, floor, tol)

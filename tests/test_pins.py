@@ -4,10 +4,22 @@ import math
 
 import numpy as np
 import pytest
-from scipy.stats import norm
+from scipy.optimize import brentq
+from scipy.stats import chi2, multivariate_normal, norm
+from scipy.stats import t as student_t
 
-from gyrocal import units
+from gyrocal import excess, units
 from gyrocal.flight.polyfit import choose_orders
+from gyrocal.models import ScaleBias
+from gyrocal.noise.figures import read_figures
+from gyrocal.pipeline import calibrate
+from gyrocal.recording import Recording
+from gyrocal.screening import screen_gaps
+from gyrocal.segmentation import Segmentation
+from gyrocal.simulation import VirtualGyro
+from gyrocal.simulation.servo import ServoProtocol, simulate_servo
+from gyrocal.verify.whitenoise import second_difference_noise
+from gyrocal.windows import Window
 
 
 def test_mad_to_sigma_is_gaussian_consistency():
@@ -24,3 +36,121 @@ def test_one_standard_error_rule_picks_lower_order():
     assert int(choose_orders(cv, k)[0]) == 1
     cv[1, 0] = best * (1 + 1.1 * slack)
     assert int(choose_orders(cv, k)[0]) == 2
+
+
+# --- the extra variances of gyrocal.excess: Student's t factor, the solved tau^2, the evidence threshold ---
+
+
+@pytest.mark.parametrize("dof", [6.5, 9.0, 30.0])
+def test_t_factor_is_students_variance(dof):
+    """Reference: the variance of Student's t with nu degrees of freedom (scipy), nu / (nu - 2) above 6."""
+    assert excess._t_factor(dof) == pytest.approx(student_t(dof).var(), rel=1e-12)
+
+
+@pytest.mark.parametrize("dof", [2.5, 4.0, 6.0])
+def test_t_factor_is_capped_at_one_and_a_half(dof):
+    """Reference: the documented cap, 1.5 at and below nu = 6 (where nu / (nu - 2) would reach 1.5 or more)."""
+    assert excess._t_factor(dof) == 1.5
+
+
+def test_extra_variance_is_the_root_of_chi2_equals_dof():
+    """Reference: the Paule-Mandel equation sum r2 / (v + c tau2) = dof solved by scipy's brentq."""
+    rng = np.random.default_rng(20)
+    v = rng.uniform(0.5, 2.0, 12)
+    c = rng.uniform(0.2, 3.0, 12)
+    r2 = 4.0 * v * rng.chisquare(1, 12)  # scatter four times the noise: tau2 > 0
+    dof = 9.0
+    root = brentq(lambda tau2: float(np.sum(r2 / (v + c * tau2))) - dof, 0.0, 1e6, xtol=1e-14)
+    assert excess._solve_tau2(r2, v, c, dof) == pytest.approx(root, rel=1e-9)
+    assert excess._solve_tau2(0.5 * dof * v / len(v), v, c, dof) == 0.0  # chi2 below dof: no extra variance
+
+
+@pytest.mark.parametrize("side, flagged", [(0.95, True), (1.05, False)])
+def test_a_group_is_widened_only_below_p_one_tenth(side, flagged):
+    """Reference: chi2.isf from scipy at p = 0.1 (the evidence threshold), with 10 rows of zero leverage."""
+    n = 10
+    z2 = np.full(n, chi2.isf(0.1 * side, n) / n)  # the group's chi2 has p = 0.1 x side
+    h = np.zeros(n)
+    out = excess._beyond_noise(z2, h, n, np.zeros(0, dtype=int))
+    assert bool(out[0]) is flagged
+
+
+# --- the paper's methods: a flagged fit has its covariance scaled by chi2/dof (Birge) ---
+
+
+def test_flagged_paper_fit_has_covariance_times_chi2_per_dof():
+    """Reference: Birge's scaling, covariance x chi2/dof with chi2 summed here from the reported residuals;
+    the unchecked fit (checks off) of the same recording gives the covariance before scaling."""
+    gyro = VirtualGyro(ScaleBias(np.array([1.0069, 0.9960, 0.9955]), np.array([0.0442, -0.0089, 0.0076])),
+                       noise_std=0.01)
+    protocol = ServoProtocol(turns=("+x", "-x", "+y", "-y", "+z", "-z") * 2, ramp=0.0, unevenness=0.02)
+    rec, _ = simulate_servo(gyro, protocol, rng=np.random.default_rng(3))
+    for method in ("lm", "algorithm1"):
+        run = calibrate(rec, speed=math.radians(60), method=method)
+        plain = calibrate(rec, speed=math.radians(60), method=method, checks=False)
+        rows = [np.asarray(r) for r in run.quality.residuals]
+        chi2_per_dof = sum(float(r @ r) for r in rows) / (sum(len(r) for r in rows) - 6)
+        assert run.quality.covariance_scaled and chi2_per_dof > 3  # the uneven plateaus are flagged
+        np.testing.assert_allclose(run.fit.covariance, plain.fit.covariance * chi2_per_dof, rtol=1e-8)
+
+
+# --- the gap bound of gyrocal.screening ---
+
+
+def test_hidden_gap_of_known_bound_gives_the_uniform_variance():
+    """Reference: the bound worked by hand, gap length x (|rate after - rate before| / 2 + 3 noise sqrt(1/na + 1/nb)),
+    and the variance of a uniform error within it, (bound / angle)^2 / 3."""
+    fs, rate, jump = 100.0, 1.0, 0.01  # [Hz], [rad/s]: the turn's rate steps by `jump` across the gap
+    n, at, lost = 700, 350, 5
+    t = np.arange(n + lost) / fs
+    t = np.delete(t, np.arange(at, at + lost))
+    w = np.zeros((n, 3))
+    w[:, 0] = np.where(np.arange(n) < at, rate, rate + jump)
+    rec = Recording(t=t, gyro=w, sample_rate=fs)
+    turn = Window(0, n, "rotation", axis="x", sign=1, angle=2 * math.pi, rate=rate)
+    seg = Segmentation(windows=(turn,), reference="angle", sample_rate=fs)
+    _, rel_var = screen_gaps(seg, rec, rec.time_base(), "angle")
+    length = (lost + 1) / fs
+    side = round(length * fs)  # samples within one gap length on either side
+    noise = math.sqrt(jump**2 / (n - 1) / 2)  # first differences: one step of `jump` among n - 1
+    bound = length * (jump / 2 + 3 * noise * math.sqrt(2 / side))
+    turned = rate * (at - 1) / fs + (rate + jump) * (n - at - 1) / fs + (2 * rate + jump) / 2 * length
+    assert rel_var[(0, n)] == pytest.approx((bound / turned) ** 2 / 3, rel=1e-9)
+
+
+# --- noise constants derived from their definitions ---
+
+
+def test_second_difference_mad_variance_from_bivariate_normal():
+    """Reference: the asymptotic variance of a median of |d| for a stationary Gaussian series, derived here:
+    n var(s_hat) / s^2 = sum over lags of cov(1{|d_0| < q}, 1{|d_k| < q}) / (q f(q))^2, with the lag-1 and lag-2
+    correlations -2/3 and 1/6 of normalised second differences on an even grid (probabilities from scipy's
+    bivariate normal); checked through the 1-sigma `second_difference_noise` reports."""
+    q = norm.ppf(0.75)
+    f = 2 * norm.pdf(q)  # density of |d| at its median, unit variance
+
+    def box(rho):  # P(|X| < q, |Y| < q) for a standard bivariate normal with correlation rho
+        law = multivariate_normal(mean=[0, 0], cov=[[1, rho], [rho, 1]])
+        return law.cdf([q, q]) - 2 * law.cdf([q, -q]) + law.cdf([-q, -q])
+
+    covs = [0.25] + [2 * (box(rho) - 0.25) for rho in (-2 / 3, 1 / 6)]  # lags 0, +-1, +-2
+    derived = sum(covs) / (q * f) ** 2
+    assert 0.25 / (q * f) ** 2 == pytest.approx(1.36, abs=0.005)  # independent values: the textbook 1.36
+    n = 1001
+    t = np.arange(n) / 100.0
+    w = np.random.default_rng(5).normal(0.0, 0.02, (n, 3))
+    est = second_difference_noise(t, w)
+    assert np.all(est.std_err**2 * (n - 2) / est.std**2 == pytest.approx(derived, rel=1e-3))
+
+
+def test_bias_instability_is_the_flat_floor_over_0664():
+    """Reference: IEEE Std 952-1997, Annex C: a flicker floor of the Allan deviation sits at
+    sqrt(2 ln 2 / pi) B = 0.6643 B; written here from the standard, not read from the code."""
+    fs, n = 100.0, 360_000
+    taus = np.logspace(-2, 3, 41)
+    floor = 1e-4
+    adev = floor * np.sqrt(1 + (0.05 / taus) + (taus / 200.0))  # white noise, a floor, a random walk
+    i_min = int(np.argmin(adev))
+    bias = read_figures(taus, np.tile(adev, (3, 1)), fs, n, level=0.683)[2]
+    expected = adev[i_min] / math.sqrt(2 * math.log(2) / math.pi)
+    np.testing.assert_allclose(bias.value[:3], expected, rtol=1e-12)

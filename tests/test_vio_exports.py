@@ -14,7 +14,10 @@ import yaml
 
 from gyrocal.errors import InputError
 from gyrocal.flight import imu_utils_yaml, kalibr_yaml, vins_yaml
-from gyrocal.noise import BI_FACTOR, characterise
+from gyrocal.noise import characterise
+
+# IEEE Std 952-1997, Annex C: a flicker floor of the Allan deviation sits at sqrt(2 ln 2 / pi) B = 0.6643 B
+FLICKER_FLOOR = math.sqrt(2 * math.log(2) / math.pi)
 
 FS = 100.0
 
@@ -67,7 +70,7 @@ def test_imu_utils_layout(report):
         for i, axis in enumerate("xyz"):
             entry = doc[block][f"{axis}-axis"]
             assert entry[f"{short}_n"] == pytest.approx(sensor.density.value[i], rel=1e-12)
-            floor = sensor.bias_instability.value[i] * BI_FACTOR  # imu_utils' *_w: the Allan minimum itself
+            floor = sensor.bias_instability.value[i] * FLICKER_FLOOR  # imu_utils' *_w: the Allan minimum itself
             assert entry[f"{short}_w"] == pytest.approx(floor, rel=1e-12)
             assert floor == pytest.approx(sensor.adev[i].min(), rel=1e-12)
         assert doc[block]["avg-axis"][f"{short}_n"] == pytest.approx(sensor.density.value[:3].mean(), rel=1e-12)
