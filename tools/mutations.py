@@ -1,0 +1,162 @@
+"""The mutations of :mod:`mutants`: one line each of the code behind an estimate or its 1-sigma.
+
+Each changes what a correct suite must notice: a term dropped, a constant about 1 % off, a factor
+not squared, an off-by-one. ``tests`` are the files tried first (the likely killers); the rest of
+the suite runs after them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Mutation:
+    name: str
+    path: str
+    old: str
+    new: str
+    why: str
+    tests: tuple[str, ...] = ()
+
+
+S = "src/gyrocal/"
+FM = S + "estimators/first_moment.py"
+EX6 = S + "estimators/_exact6.py"
+SEL = ("tests/test_pins.py", "tests/test_selfcheck.py", "tests/test_realistic.py", "tests/test_estimators.py")
+MUTATIONS = [
+    # estimators: the first-moment rows, weights and sandwich covariance
+    Mutation("fm-rot-weight", FM, "w_rot = np.sqrt(obs.count[rot])[None, :, None]",
+             "w_rot = np.sqrt(obs.count[rot] + 1)[None, :, None]", "rotation rows weighted sqrt(n + 1)",
+             ("tests/test_estimators.py",)),
+    Mutation("fm-static-weight", FM, "w_sta = np.sqrt(obs.count[sta])[None, :, None]",
+             "w_sta = (obs.count[sta] ** 0.49)[None, :, None]", "static rows weighted n^0.49", SEL),
+    Mutation("fm-jacobian-b", FM, "J_rot = np.concatenate([u * (obs.mean[:, rot] + b), u * k], axis=-1) * w_rot",
+             "J_rot = np.concatenate([u * (obs.mean[:, rot] + b), u], axis=-1) * w_rot",
+             "the bias column of a turn's Jacobian without k", SEL),
+    Mutation("fm-rate-var", FM, "extra[:n_rot] = (obs.count * obs.rate_var)[~obs.static]",
+             "extra[:n_rot] = (obs.rate_var)[~obs.static]", "a reference's variance not times the count", SEL),
+    Mutation("fm-sandwich", FM, "return Hinv @ meat @ Hinv", "return Hinv", "the sandwich's meat dropped", SEL),
+    Mutation("fm-mean-var", FM, "nu = np.where(np.isnan(obs.mean_var), nu, obs.mean_var * obs.count[None, :, None])",
+             "nu = np.where(np.isnan(obs.mean_var), nu, obs.mean_var * 1.02 * obs.count[None, :, None])",
+             "a measured window-mean variance 2 % high", SEL),
+    Mutation("noise-pool", S + "estimators/_noise.py", "w = (a < top[:, None]) * count[:, None, None]",
+             "w = (a <= top[:, None]) * count[:, None, None]", "the rotating axis's noise pooled in",
+             ("tests/test_estimators.py", "tests/test_pipeline.py")),
+    Mutation("exact6-noise", EX6, "q = 4 * np.einsum(", "q = 3.96 * np.einsum(",
+             "closed form: the variance of F 1 % low", ("tests/test_estimators.py", "tests/test_fast_path.py")),
+    Mutation("exact6-b", EX6, "k, b = np.sqrt(beta[:3]), beta[3:] / (2 * beta[:3])",
+             "k, b = np.sqrt(beta[:3]), beta[3:] / (2.02 * beta[:3])", "closed form: b 1 % low",
+             ("tests/test_estimators.py",)),
+    # moments of a window
+    Mutation("moments-noise", S + "moments.py", "noise / (count - 1)[:, None] / 2.0",
+             "noise / count[:, None] / 2.0", "first-difference noise over n, not n - 1",
+             ("tests/test_estimators.py", "tests/test_observations.py")),
+    # the extra variances (Paule-Mandel)
+    Mutation("excess-t-factor", S + "excess.py", "return dof / (dof - 2) if dof > 6 else 1.5",
+             "return 1.0 if dof > 6 else 1.5", "Student's t factor dropped", SEL),
+    Mutation("excess-t-cap", S + "excess.py", "return dof / (dof - 2) if dof > 6 else 1.5",
+             "return dof / (dof - 2) if dof > 6 else 1.0", "no t factor at few degrees of freedom", SEL),
+    Mutation("excess-evidence", S + "excess.py", "EVIDENCE_P = 0.1", "EVIDENCE_P = 0.01",
+             "evidence threshold 0.1 -> 0.01", SEL),
+    Mutation("excess-leverage", S + "excess.py", "dof = float(np.sum(1 - h[rows]))", "dof = float(len(h[rows]))",
+             "degrees of freedom without the leverages", SEL),
+    Mutation("excess-turn-angle", S + "excess.py", "c_turn = count_rot / obs.duration[rot] ** 2 if",
+             "c_turn = count_rot / obs.duration[rot] if", "an angle's extra variance not over T^2", SEL),
+    Mutation("excess-solve", S + "excess.py", "        if float(np.sum(r2 / (v + c * mid))) > dof:",
+             "        if float(np.sum(r2 / (v + c * mid))) > 1.02 * dof:", "chi2 solved for 1.02 dof", SEL),
+    # the paper's methods: Birge scaling
+    Mutation("birge-not-squared", S + "fit_checks.py", "fit.covariance * quality.birge_ratio**2",
+             "fit.covariance * quality.birge_ratio", "Birge ratio not squared", SEL),
+    Mutation("quality-threshold", S + "quality.py", "P_THRESHOLD = 1e-3", "P_THRESHOLD = 1e-4",
+             "flag threshold 1e-3 -> 1e-4", SEL + ("tests/test_cli_selfcheck.py",)),
+    Mutation("quality-dof", S + "quality.py", "dof = rows - n_params", "dof = rows - n_params + 1",
+             "one degree of freedom too many", SEL),
+    # gaps hidden inside a turn
+    Mutation("gap-variance-10", S + "screening.py", "(bound / turned) ** 2 / 3.0", "(bound / turned) ** 2 / 30.0",
+             "the gap variance divided by 10", SEL),
+    Mutation("gap-noise-term", S + "screening.py",
+             "/ 2 + 3 * noise * math.sqrt(1 / len(ra) + 1 / len(rb))", "/ 2",
+             "the gap bound without its noise term", SEL),
+    Mutation("reference-sd", S + "screening.py", "rel += (reference_sd / size) ** 2",
+             "rel += (reference_sd / size) ** 2 / 2", "the declared angle accuracy halved in variance", SEL),
+    # long-run variances of window means
+    Mutation("nw-bartlett", S + "longrun.py", "s = s + 2 * (1 - h / (lags + 1)) *", "s = s + 2 * (1 - h / lags) *",
+             "Bartlett weights off by one", ("tests/test_fast_paths.py",) + SEL),
+    Mutation("nw-recolour", S + "longrun.py", "return np.maximum(s, 0.0) / (1.0 - rho) ** 2 / n",
+             "return np.maximum(s, 0.0) / (1.0 - rho) / n", "prewhitening not recoloured by (1 - rho)^2",
+             ("tests/test_fast_paths.py",) + SEL),
+    Mutation("span-shrink", S + "longrun.py", "shrink += len(d) * (1 - L / len(r))", "shrink += len(d)",
+             "a window's own mean not removed from its span sums", ("tests/test_fast_paths.py",) + SEL),
+    Mutation("span-mean-var", S + "window_stats.py", "b * fits[i][1] + a * fits[i][1] ** 2",
+             "b * fits[i][1] + a * fits[i][1]", "a plateau mean's correlated term not squared",
+             ("tests/test_fast_paths.py",) + SEL),
+    Mutation("pooled-lrv", S + "window_stats.py", "return newey_west_var(chosen) * len(chosen)",
+             "return newey_west_var(chosen) * (len(chosen) - 1)", "pooled long-run variance over n - 1",
+             ("tests/test_fast_paths.py",) + SEL),
+    # time base
+    Mutation("period-block", S + "timebase.py", "return float(np.median(np.diff(ends))) / block",
+             "return float(np.mean(np.diff(ends))) / block", "period from the mean of block steps (gaps pull it)",
+             ("tests/test_timebase.py", "tests/test_fast_paths.py")),
+    Mutation("timegaps-rise", S + "timegaps.py", "rise = np.flatnonzero(np.diff(floor) >= 0.5 * period)",
+             "rise = np.flatnonzero(np.diff(floor) >= 1.5 * period)", "a gap needs a rise of 1.5 periods",
+             ("tests/test_timebase.py", "tests/test_fast_paths.py")),
+    Mutation("least-delayed", S + "timegaps.py", "    k = len(x) // 10\n", "    k = len(x) // 5\n",
+             "least-delayed level at the fifth, not tenth, quantile",
+             ("tests/test_timebase.py", "tests/test_fast_paths.py")),
+    # MAD and stillness
+    Mutation("mad-constant", S + "units.py", "MAD_TO_SIGMA = ", "MAD_TO_SIGMA = 1.01 * ", "MAD factor x 1.01",
+             ("tests/test_pins.py",)),
+    Mutation("stillness-jump", S + "stillness.py", "nsigma * np.sqrt(2.0) * scale", "nsigma * scale",
+             "a jump between blocks judged without sqrt 2", ("tests/test_stillness.py",)),
+    Mutation("quiet-noise", S + "observed.py", "var(axis=1, ddof=1)", "var(axis=1, ddof=0)",
+             "quiet-block noise variance with ddof 0", ("tests/test_cli_newcomer.py", "tests/test_cli_selfcheck.py")),
+    # noise figures
+    Mutation("whitenoise-constant", S + "verify/whitenoise.py", "_MAD_VARIANCE = 1.977", "_MAD_VARIANCE = 1.997",
+             "second-difference MAD variance 1 % high", ("tests/test_pins.py", "tests/test_verify_metrics.py")),
+    Mutation("whitenoise-weights", S + "verify/whitenoise.py", "np.sqrt(1.0 + lam**2 + (1.0 - lam) ** 2)",
+             "np.sqrt(1.0 + lam**2)", "second differences normalised without one neighbour",
+             ("tests/test_verify_metrics.py",)),
+    Mutation("bias-instability", S + "noise/figures.py", "BI_FACTOR = math.sqrt(2.0 * math.log(2.0) / math.pi)",
+             "BI_FACTOR = 0.5", "bias-instability factor 0.5", ("tests/test_pins.py", "tests/test_noise.py")),
+    Mutation("density-tau", S + "noise/figures.py", "density = none if i is None else at(i, 0, math.sqrt(taus[i]))",
+             "density = none if i is None else at(i, 0, math.sqrt(1.01 * taus[i]))", "noise density read 0.5 % high",
+             ("tests/test_noise.py",)),
+    Mutation("random-walk", S + "noise/figures.py", "walk = none if i is None else at(i, -2, math.sqrt(3.0 / taus[i]))",
+             "walk = none if i is None else at(i, -2, math.sqrt(2.9 / taus[i]))", "rate random walk 1.7 % low",
+             ("tests/test_noise.py",)),
+    Mutation("allan-edf", S + "noise/figures.py", "mult = 3.0 if pooled else 1.0", "mult = 3.0 if pooled else 1.5",
+             "an axis's Allan points with 1.5x their degrees of freedom", ("tests/test_noise.py",)),
+    # thermal: the full-temperature-range method and the thermal-bias curve
+    Mutation("thermal-point-dof", S + "thermal/fit.py", "dof = max(len(ref) - 4, 1)", "dof = max(len(ref) - 3, 1)",
+             "a temperature point's residual dof one too many", ("tests/test_thermal_fit.py",)),
+    Mutation("thermal-point-noise", S + "thermal/fit.py", "var_noise = (H ** 2) @", "var_noise = H @",
+             "noise-propagated variance with H, not H^2", ("tests/test_thermal_fit.py",)),
+    Mutation("smooth-one-se", S + "thermal/smooth.py", "best * (1 + 1 / np.sqrt(2 * len(t)))",
+             "best * (1 + 1 / np.sqrt(len(t)))", "LOTO order rule with 1/sqrt(n)",
+             ("tests/test_thermal_model.py", "tests/test_thermal_lagrange.py")),
+    Mutation("polyfit-one-se", S + "flight/polyfit.py", "best * (1 + 1 / math.sqrt(2 * n_segments))",
+             "best * (1 + 1 / math.sqrt(n_segments))", "thermal-bias order rule with 1/sqrt(K)",
+             ("tests/test_pins.py", "tests/test_thermal_bias.py")),
+    Mutation("ar1-white", S + "flight/polyfit.py", "cov = white_var * B + s2 * C", "cov = s2 * C + 0 * B",
+             "the thermal-bias covariance without its white term", ("tests/test_thermal_bias.py",)),
+    Mutation("ar1-phi-grid", S + "flight/polyfit.py", "np.linspace(0.0, 0.995, 100)[1:]",
+             "np.linspace(0.0, 0.5, 100)[1:]", "wander correlation searched only up to 0.5",
+             ("tests/test_thermal_bias.py",)),
+    # design: the Cramér-Rao bound
+    Mutation("crb-row-var", S + "design.py", "row_var = np.einsum(\"bmj,j->bm\", S * S, nv)",
+             "row_var = np.einsum(\"bmj,j->bm\", S * S, nv) * 1.02", "Fisher information 2 % low",
+             ("tests/test_design.py", "tests/test_planning.py")),
+    Mutation("crb-density", S + "design.py", "np.asarray(noise_density, dtype=float) * math.sqrt(sample_rate)",
+             "np.asarray(noise_density, dtype=float) * math.sqrt(sample_rate / 2)", "density to noise without 2",
+             ("tests/test_design.py", "tests/test_planning.py")),
+    # the C library's window accumulator and closed form
+    Mutation("c-accum-var", S + "c/gyrocal_cal.c", "float var = (acc->s2[i] + acc->c2[i]) / n - m1 * m1;",
+             "float var = (acc->s2[i] + acc->c2[i]) / n;", "C: variance without the mean's square",
+             ("tests/test_c_native.py", "tests/test_firmware.py")),
+    Mutation("c-accum-mean", S + "c/gyrocal_cal.c", "float m1 = (acc->s1[i] + acc->c1[i]) / n;",
+             "float m1 = acc->s1[i] / n;", "C: mean without Neumaier's compensation",
+             ("tests/test_c_native.py", "tests/test_firmware.py")),
+    Mutation("c-return-step", S + "c/gyrocal_cal.c", "k[j] = sqrtf(beta[j]);", "k[j] = beta[j];",
+             "C: k without the square root", ("tests/test_c_native.py", "tests/test_firmware.py")),
+]
