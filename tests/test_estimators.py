@@ -34,20 +34,29 @@ def crb_std(k, b, design, sigma=SIGMA):
     return np.array([np.sqrt(np.diag(crb_covariance(design, ScaleBias(ki, bi), sigma))) for ki, bi in zip(k, b)])
 
 
+def _assert_unit_rms(z: np.ndarray) -> None:
+    """Two-sided: RMS of m standard-normal z is 1 +- 1/sqrt(2m); 4 of those (too wide fails as well as too narrow)."""
+    rms = float(np.sqrt(np.mean(np.square(z))))
+    assert abs(rms - 1) < 4 / math.sqrt(2 * z.size), rms
+
+
 @pytest.mark.parametrize("static", [0.0, 3.0], ids=["six", "six+static"])
 def test_contract_first_moment_truth_within_4_sigma(rng, static):
+    """Reference: the simulated truth of 20 gyros; the reported 1-sigma judged two-sided by the RMS of 120 z."""
     k, b = truth(rng, 20)
     obs = paper_observations(k, b, speed=SPEED, static_duration=static, rng=rng)
     fit = FirstMoment().fit_batch(obs)
     z = (fit.params - np.concatenate([k, b], 1)) / fit.std
     assert np.all(np.abs(z) < 4), np.abs(z).max()
+    _assert_unit_rms(z)
     assert fit.converged.all()
 
 
 @pytest.mark.parametrize("estimator", [Algorithm1(tol=1e-12), PaperLM()], ids=["algorithm1", "lm"])
 def test_contract_paper_estimators_truth_within_4_sigma(rng, estimator):
     """Without jitter the mean of squares adds only the sample variance of the noise, which
-    scales k by sqrt(w^2 / (w^2 + sum k^2 s^2)) (see test_accuracy); the rest is first-moment noise."""
+    scales k by sqrt(w^2 / (w^2 + sum k^2 s^2)) (see test_accuracy); the rest is first-moment noise.
+    Reference: that expected k and the true b of 20 gyros, in units of the CRB (RMS of 120 z, two-sided)."""
     k, b = truth(rng, 20)
     obs = paper_observations(k, b, speed=SPEED, jitter=0.0, misalignment=0.1, rng=rng)
     fit = estimator.fit_batch(obs)
@@ -56,6 +65,7 @@ def test_contract_paper_estimators_truth_within_4_sigma(rng, estimator):
     sd = crb_std(k, b, Design.paper_six(SPEED))
     z = (fit.params - np.concatenate([k_expected, b], 1)) / sd
     assert np.all(np.abs(z) < 4), np.abs(z).max()
+    _assert_unit_rms(z)
 
 
 @pytest.mark.parametrize("method", ["first-moment", "algorithm1", "lm"])

@@ -217,7 +217,9 @@ def _random_session(rng: np.random.Generator):
 
 def test_random_sessions_find_every_turn_and_the_truth(rng):
     """Many protocols: every turn is found (two turns about one axis and sense with no wait
-    at all may read as one 720 deg turn with --angle) and the truth lies within 4 sigma."""
+    at all may read as one 720 deg turn with --angle) and the truth lies within 4 sigma. The 1-sigma is judged
+    two-sided: the RMS of all z (about 270) within 4 sd of the RMS of that many normals, 1 +- 4 / sqrt(2 m)."""
+    zs = []
     for _ in range(25):
         rec, p, turns, waits, hand, truth = _random_session(rng)
         for ref in ("angle",) if hand else ("speed", "angle"):
@@ -228,6 +230,9 @@ def test_random_sessions_find_every_turn_and_the_truth(rng):
             assert labels in (turns, [t for i, t in enumerate(turns) if i not in joined]), (p, ref)
             z = (run.fit.model.params - truth) / run.fit.std
             assert np.all(np.abs(z) < 4), (p, ref, z)
+            zs.append(z)
+    rms = float(np.sqrt(np.mean(np.square(zs))))
+    assert abs(rms - 1) < 4 / math.sqrt(2 * np.size(zs)), rms
 
 
 def test_turns_too_short_for_a_plateau_point_to_the_angle_reference(rng):
