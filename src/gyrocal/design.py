@@ -237,6 +237,9 @@ def information_matrix(design: Design, model=None, noise_std=None, sample_rate: 
                        noise_density=None) -> np.ndarray:
     """Fisher information (6, 6) of ``(k, b)`` [1/unit^2] for white noise on the window means.
 
+    Each turn's axis direction is unknown, as in the norm equations (a mount is never exact): the
+    bound on b is wider than with known axes (3x in variance for the six turns of Wang et al.).
+
     Parameters
     ----------
     design : Design
