@@ -85,10 +85,14 @@ def _json_object(path: Path) -> dict | None:
 
 def same_document(doc: dict) -> Callable[[Path], bool]:
     """A `replaceable` test: the file is JSON holding `doc` (apart from which gyrocal wrote it)."""
-    drop = ("created_by",)
-    mine = {k: v for k, v in doc.items() if k not in drop}
-    return lambda path: (old := _json_object(path)) is not None and {
-        k: v for k, v in old.items() if k not in drop} == mine
+    def kept(d: dict) -> dict:
+        out = {k: v for k, v in d.items() if k != "created_by"}
+        if isinstance(out.get("unit"), dict):  # the same unit's result, made again at another time
+            out["unit"] = {k: v for k, v in out["unit"].items() if k not in ("created", "software")}
+        return out
+
+    mine = kept(doc)
+    return lambda path: (old := _json_object(path)) is not None and kept(old) == mine
 
 
 def json_format(fmt: str) -> Callable[[Path], bool]:

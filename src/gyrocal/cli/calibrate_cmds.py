@@ -21,6 +21,7 @@ from ..errors import GyrocalError, InputError
 from ._outputs import check_output, same_document
 from ._reading import READING, read_from_flags, required_units
 from ._references import density_to_internal, noise_to_internal, rate_unit_of, reference_of
+from ._station import STATION, StationFlags, finish, print_verdict, store_result
 from .app import app, console, message, warn
 
 __all__ = ["calibrate", "segments"]
@@ -195,9 +196,22 @@ def calibrate(
     example: Annotated[bool, typer.Option(
         "--example", help="Run on the bundled simulated MPU9250 servo recording (deg/s, --speed 60 unless "
         "--angle or --windows).")] = False,
+    unit: STATION.Unit = None,
+    part: STATION.Part = None,
+    revision: STATION.Revision = None,
+    station: STATION.Station = None,
+    operator: STATION.Operator = None,
+    fixture: STATION.Fixture = None,
+    procedure: STATION.Procedure = None,
+    limits: STATION.Limits = None,
+    store: STATION.Store = None,
 ) -> None:
     """Estimate scale and bias from a recording of turns; print them with 1-sigma; write the calibration file."""
+    # long function: the command's steps in order (flags, reading, fit, outputs, station), each a call of its own
     from ..pipeline import calibrate as run_calibration
+
+    flags = StationFlags(unit, part, revision, station, operator, fixture, procedure, limits, store)
+    flags.check()
 
     truth_path = None
     if example:
@@ -227,8 +241,8 @@ def calibrate(
     run = run_calibration(rec, speed=speed_rad, angle=angle_rad, method=method, windows=win, noise_std=noise,
                           output_units=rate_unit, reference_sd=ref_sd)
     cal = _with_notes(run.calibration, read_notes)
-    doc = cal.to_document()
     inputs = (Path(recording), windows)
+    doc, verdict = finish(cal.to_document(), flags, inputs=inputs)
     check_output(output, inputs=inputs, force=force, replaceable=same_document(doc),
                  holds="a different calibration or another file")
     check_output(plot, flag="--plot", inputs=inputs + (output,), outputs=(output,), force=True)
@@ -239,14 +253,20 @@ def calibrate(
         windows_used = [Window.from_dict(d) for d in cal.windows]
         _save_plot(plot, rec, windows_used, cal, speed_rad, f"{Path(recording).name}: {reference} reference")
     if output is not None:
-        from ..files import save
+        from .._jsonfile import write_json
 
-        save(cal, output)
+        write_json(output, doc)
+    record = store_result(doc, flags, verdict, kind="calibration", job="calibrate", args="", inputs=inputs)
     if example:
         console.print(intro, highlight=False, soft_wrap=True)
     _print_calibration(run, None if truth_path is None else _truth_calibration(truth_path, cal))
     if output is not None:
         console.print(f"wrote {output}" + (f" and {plot}" if plot is not None else ""), highlight=False)
+    if record is not None:
+        console.print(f"stored as record {record} in {store}", highlight=False)
+    print_verdict(console, doc)
+    if verdict == "fail":
+        raise typer.Exit(1)
 
 
 def _with_notes(cal, notes: list):

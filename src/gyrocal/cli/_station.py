@@ -1,0 +1,147 @@
+"""The station's flags, shared by every command that writes a result: identity, limits, store.
+
+:func:`finish` is the one ending of such a command: the result document gets its ``unit`` section
+and its acceptance, is written atomically, is stored as a new record, and the command's exit code
+says the verdict (0 pass or no limits, 1 fail). Library imports happen inside the functions, so
+``gyrocal --help`` stays fast.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ..errors import InputError
+
+__all__ = ["STATION", "StationFlags", "finish", "print_verdict", "store_result"]
+
+_PANEL = "Production station"
+
+
+def _opt(flag: str, text: str, metavar: str = "TEXT"):
+    return typer.Option(flag, help=text, rich_help_panel=_PANEL, metavar=metavar)
+
+
+class STATION:
+    """Annotated option types; a command takes them as parameters and passes them to :class:`StationFlags`."""
+
+    Unit = Annotated[Optional[str], _opt("--unit", "Serial number of the unit: recorded in the file's 'unit' "
+                                         "section with the inputs' SHA-256, the software and the time (default: "
+                                         "none).", "SERIAL")]
+    Part = Annotated[Optional[str], _opt("--part", "Part number of the unit (default: none).")]
+    Revision = Annotated[Optional[str], _opt("--revision", "Hardware revision of the unit (default: none).")]
+    Station = Annotated[Optional[str], _opt("--station", "Calibration station's name (default: none).")]
+    Operator = Annotated[Optional[str], _opt("--operator", "Who ran the calibration (default: none).")]
+    Fixture = Annotated[Optional[str], _opt("--fixture", "Fixture or turntable used (default: none).")]
+    Procedure = Annotated[Optional[str], _opt("--procedure", "Procedure as NAME@VERSION (default: none).",
+                                              "NAME@VERSION")]
+    Limits = Annotated[Optional[Path], _opt("--limits", "Acceptance limits (TOML): each value +- guard x sigma "
+                                            "must lie inside its bounds; exit 1 when any fails (default: none).",
+                                            "FILE")]
+    Store = Annotated[Optional[str], _opt("--store", "Calibration store: an SQLite file (a path or "
+                                          "sqlite:///path) or postgresql://user@host:port/db; the result is "
+                                          "added as a new record (default: none).", "URL")]
+
+
+@dataclass(frozen=True)
+class StationFlags:
+    """What a command was given of :class:`STATION`'s flags."""
+
+    unit: str | None = None
+    part: str | None = None
+    revision: str | None = None
+    station: str | None = None
+    operator: str | None = None
+    fixture: str | None = None
+    procedure: str | None = None
+    limits: Path | None = None
+    store: str | None = None
+
+    def check(self) -> None:
+        """Refuse what cannot work before any reading or fitting is done."""
+        if self.unit is None and any(v is not None for v in (self.part, self.revision, self.fixture, self.procedure)):
+            raise InputError("--part, --revision, --fixture and --procedure describe a unit: give its --unit SERIAL too")
+        if self.store is not None and self.unit is None:
+            raise InputError("--store keeps records per unit: give --unit SERIAL too")
+        self.identity()  # checks the serial and the procedure now, not after the fit
+        if self.limits is not None:
+            from ..station.limits import read_limits
+
+            read_limits(self.limits)
+
+    def identity(self):
+        if self.unit is None:
+            return None
+        from ..station.identity import Identity
+
+        return Identity(self.unit, self.part, self.revision, self.station, self.operator, self.fixture,
+                        self.procedure)
+
+
+def finish(doc: dict, flags: StationFlags, *, inputs, device_id: int | None = None) -> tuple[dict, str | None]:
+    """Stamp `doc` with the unit and the acceptance; add it to the store. Returns the document and the verdict.
+
+    The caller writes the returned document (atomically) before the store is written, so a stored
+    record always has its file; the verdict is None without limits.
+    """
+    files = [Path(p) for p in inputs if p is not None]
+    identity = flags.identity()
+    if identity is not None:
+        from ..station.identity import unit_section
+
+        doc = {**doc, "unit": unit_section(identity, files, device_id=device_id)}
+    verdict = None
+    if flags.limits is not None:
+        from ..station.accept import accept
+        from ..station.limits import read_limits
+
+        acceptance = accept(doc, read_limits(flags.limits))
+        doc = {**doc, "acceptance": acceptance.to_document()}
+        verdict = acceptance.verdict
+    return doc, verdict
+
+
+def store_result(doc: dict, flags: StationFlags, verdict: str | None, *, kind: str, job: str, args: str,
+                 inputs) -> int | None:
+    """Add the finished document to the store as a new record; its id, or None without --store."""
+    if flags.store is None:
+        return None
+    from ..station.identity import sha256_of
+    from ..store import open_store
+
+    unit = doc.get("unit") or {}
+    hashes = [sha256_of(p) for p in inputs if p is not None]
+    store = open_store(flags.store)
+    try:
+        return store.add(serial=unit.get("serial") or flags.unit, kind=kind, document=doc, station=flags.station,
+                         operator=flags.operator, verdict=verdict, input_sha256=hashes[0] if len(hashes) == 1 else hashes,
+                         job=job, args=args)
+    finally:
+        store.close()
+
+
+def print_verdict(console, doc: dict) -> None:
+    """The acceptance table, then one line a test engineer reads from across the bench."""
+    acc = doc.get("acceptance")
+    if acc is None:
+        return
+    from rich.table import Table
+
+    table = Table(title="acceptance (value +- guard x sigma inside the bounds)")
+    for col in ("criterion", "value", "1-sigma", "low", "high", "unit", "margin", "verdict"):
+        table.add_column(col, justify="left" if col in ("criterion", "unit", "verdict") else "right", no_wrap=True)
+    for c in acc["criteria"]:
+        def num(x):
+            return "-" if x is None else f"{x:.6g}"
+        table.add_row(c["name"], num(c["value"]), num(c["sigma"]), num(c["low"]), num(c["high"]), c["unit"],
+                      num(c["margin"]), c["verdict"].upper())
+    console.print(table)
+    if acc["not_applicable"]:
+        console.print(f"not in this result: {', '.join(acc['not_applicable'])}", highlight=False)
+    failed = [c["name"] for c in acc["criteria"] if c["verdict"] != "pass"]
+    serial = (doc.get("unit") or {}).get("serial")
+    who = f"{serial}: " if serial else ""
+    console.print(f"{who}{'PASS' if not failed else 'FAIL (' + ', '.join(failed) + ')'}", highlight=False)

@@ -1,0 +1,6 @@
+"""The production station: unit identity, acceptance limits with guard bands, and what builds on them.
+
+* :mod:`.identity`: the ``unit`` section of a result file (serial, station, procedure, input hashes);
+* :mod:`.limits`: the limits file (TOML) and its bounds;
+* :mod:`.accept`: the guard-banded decision of a result against limits.
+"""
