@@ -21,7 +21,7 @@ COMMAND_MODULES = ("calibrate_cmds", "imu_cmds", "apply_cmds", "export_cmds", "t
                    "station_cmds")
 #: Order of the commands in ``gyrocal --help``; commands not listed follow by name.
 HELP_ORDER = ("calibrate", "segments", "apply", "export", "imu", "verify", "compare", "thermal", "thermal-report",
-              "noise", "thermal-bias", "simulate", "plan", "study", "capture", "accept", "store")
+              "noise", "thermal-bias", "simulate", "plan", "study", "capture", "accept", "certificate", "store")
 
 for _name in COMMAND_MODULES:
     importlib.import_module(f"{__name__}.{_name}")

@@ -62,3 +62,41 @@ def accept(
         console.print(f"stored as record {record} in {store}", highlight=False)
     if not acceptance.passed:
         raise typer.Exit(1)
+
+
+@app.command()
+def certificate(
+    unit: Annotated[str, typer.Argument(help="A result file with a 'unit' section, or a serial number with --store.")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Certificate to write: .html or .pdf.")],
+    store: STATION.Store = None,
+    force: Annotated[bool, typer.Option("--force", help="Replace an existing certificate.")] = False,
+) -> None:
+    """Write a unit's calibration certificate (HTML or PDF): identity, results with 1-sigma, limits, verdicts."""
+    from ..station.certificate import write_certificate
+
+    if store is None:
+        doc, record = _read_result(Path(unit)), f"file {Path(unit).name}"
+        inputs = (Path(unit),)
+    else:
+        doc, record = _latest_calibration(store, unit)
+        inputs = ()
+    check_output(output, flag="--output", inputs=inputs, force=force,
+                 replaceable=lambda path: path.suffix.lower() in (".html", ".htm", ".pdf"))
+    write_certificate(doc, output, record)
+    verdict = (doc.get("acceptance") or {}).get("verdict")
+    console.print(f"wrote {output}: {doc['unit']['serial']} " + (verdict.upper() if verdict else "(no limits applied)"),
+                  highlight=False)
+
+
+def _latest_calibration(url: str, serial: str) -> tuple[dict, str]:
+    from ..station.identity import check_serial
+    from ..store import is_calibration_kind, open_store
+
+    serial = check_serial(serial, "SERIAL")
+    with open_store(url) as st:
+        records = [r for r in st.history(serial) if is_calibration_kind(r.kind)]
+    if not records:
+        raise InputError(f"the store {url} holds no calibration of unit {serial!r}; calibrate it with --unit {serial} "
+                         f"--store {url}")
+    r = records[0]
+    return r.document, f"record {r.id} of {url}, {r.created:%Y-%m-%dT%H:%M:%SZ}"
