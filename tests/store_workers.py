@@ -16,6 +16,7 @@ def insert_many(url: str, worker: int, count: int, barrier, results) -> None:
 
 def create_and_add(url: str, worker: int, barrier, results) -> None:
     """Wait for the others, then open (and so create) the store at `url` and add one record."""
+    import gyrocal.store.store  # noqa: F401 - SQLAlchemy and Alembic loaded before the race, not during it
     from gyrocal.store import open_store
 
     barrier.wait(timeout=60)

@@ -81,8 +81,8 @@ def store_error(url: StoreURL, exc: BaseException) -> StoreError:
         return StoreError(f"cannot reach store {url.display}: {_first_line(exc)}",
                           hint="check that the PostgreSQL server runs and the URL's host, port and database")
     if _locked(exc):
-        return StoreError(f"store {url.display} stayed locked by another writer for more than "
-                          f"{ATTEMPTS} x {BUSY_TIMEOUT_S:g} s")
+        return StoreError(f"store {url.display} stayed locked by another writer ({ATTEMPTS} tries, each waiting "
+                          f"up to {BUSY_TIMEOUT_S:g} s)")
     return StoreError(f"cannot use store {url.display}: {_first_line(exc)}")
 
 
