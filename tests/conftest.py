@@ -30,3 +30,33 @@ def pytest_terminal_summary(terminalreporter):
                                     red=True)
         for line in _NOT_RUN:
             terminalreporter.write_line(f"  {line}", red=True)
+
+
+@pytest.fixture(scope="session")
+def pg_server():
+    """A PostgreSQL server for this test session (tests/pg_server.py); a missing binary fails, never skips."""
+    from pg_server import MissingPostgres, PostgresServer
+
+    try:
+        server = PostgresServer()
+        server.start()
+    except (MissingPostgres, RuntimeError) as exc:
+        pytest.fail(str(exc), pytrace=False)
+    yield server
+    server.stop()
+
+
+@pytest.fixture
+def pg_url(pg_server, request) -> str:
+    """The URL of a fresh, empty database on the session's PostgreSQL server."""
+    import zlib
+
+    return pg_server.create_database(f"t{zlib.crc32(request.node.nodeid.encode()):08x}")
+
+
+@pytest.fixture(params=["sqlite", "postgresql"])
+def store_url(request, tmp_path) -> str:
+    """A fresh store's URL: an SQLite file in tmp_path, then a fresh PostgreSQL database."""
+    if request.param == "sqlite":
+        return str(tmp_path / "store.db")
+    return request.getfixturevalue("pg_url")

@@ -29,7 +29,14 @@ FORBIDDEN: dict[str, set[str]] = {
     "plotting": {"cli", "io", "studies"},
     "io": {"cli", "plotting", "simulation", "studies", "thermal"},
     "studies": {"cli"},
+    # the calibration store keeps results; it computes nothing and knows no file format or front end
+    "store": _FRONT | {"files", "firmware", "thermal", "calibration", "pipeline"},
 }
+#: Components that never use the store (it is for front ends and batch jobs, not for the numerics).
+for _core in ("models", "observations", "estimators", "design", "segmentation", "windows", "recording", "units",
+              "saturation", "planning", "noise", "stillness", "flight", "imu", "thermal", "simulation", "io",
+              "plotting"):
+    FORBIDDEN[_core] = FORBIDDEN.get(_core, set()) | {"store"}
 #: Modules of gyrocal.cli that hold commands; each may import none of the others.
 CMDS_SUFFIX = "_cmds"
 #: Module-level imports a command module may make: ``gyrocal --help`` must not load numpy.
@@ -145,6 +152,25 @@ def test_the_check_catches_what_it_forbids(tmp_path, monkeypatch, bad, message):
     finally:
         planted.unlink()
     assert any(message in p for p in problems), problems
+
+
+def test_the_package_imports_without_the_store_extra():
+    """gyrocal, gyrocal.store and the command line load no SQLAlchemy; with it blocked, opening a store says
+    which extra to install in one line."""
+    code = ("import sys\n"
+            "import gyrocal, gyrocal.cli, gyrocal.store\n"
+            "print(','.join(sorted(m for m in ('sqlalchemy', 'alembic', 'psycopg') if m in sys.modules)))\n"
+            "sys.modules['sqlalchemy'] = None\n"
+            "from gyrocal.errors import MissingDependencyError\n"
+            "try:\n"
+            "    gyrocal.store.open_store('never-created.db')\n"
+            "except MissingDependencyError as exc:\n"
+            "    print(exc)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True,
+                         cwd=SRC.parent)
+    loaded, message = out.stdout.splitlines()
+    assert loaded == "" and message.startswith("the calibration store needs SQLAlchemy")
+    assert "pip install 'gyrocal[store]'" in message
 
 
 def test_the_command_line_starts_without_numpy():

@@ -29,6 +29,7 @@ __all__ = [
     "SegmentationError",
     "MissingDependencyError",
     "OutOfRangeError",
+    "StoreError",
     "GyrocalWarning",
 ]
 
@@ -137,6 +138,10 @@ class MissingDependencyError(GyrocalError, ImportError):
 
 class OutOfRangeError(GyrocalError):
     """A temperature lies outside the calibrated range and no extrapolation was allowed."""
+
+
+class StoreError(GyrocalError):
+    """A calibration store cannot be used: unreachable, locked too long, or of a newer schema than this gyrocal."""
 
 
 class GyrocalWarning(UserWarning):
