@@ -93,6 +93,8 @@ def finish(doc: dict, flags: StationFlags, *, inputs, device_id: int | None = No
         from ..station.identity import unit_section
 
         doc = {**doc, "unit": unit_section(identity, files, device_id=device_id)}
+    if flags.store is not None:
+        doc = _with_as_found(doc, flags)
     verdict = None
     if flags.limits is not None:
         from ..station.accept import accept
@@ -102,6 +104,20 @@ def finish(doc: dict, flags: StationFlags, *, inputs, device_id: int | None = No
         doc = {**doc, "acceptance": acceptance.to_document()}
         verdict = acceptance.verdict
     return doc, verdict
+
+
+def _with_as_found(doc: dict, flags: StationFlags) -> dict:
+    """`doc` with ``as_found``/``as_left`` when the store holds a calibration of the unit in force now."""
+    from ..station.asfound import as_found_and_left
+    from ..store import open_store
+
+    with open_store(flags.store) as store:
+        previous = store.in_force(flags.unit)
+    if previous is None:
+        return doc
+    parts = as_found_and_left(doc, previous.document, record=previous.id,
+                              created=previous.created.strftime("%Y-%m-%dT%H:%M:%SZ"))
+    return doc if parts is None else {**doc, "as_found": parts[0], "as_left": parts[1]}
 
 
 def store_result(doc: dict, flags: StationFlags, verdict: str | None, *, kind: str, job: str, args: str,
@@ -114,13 +130,13 @@ def store_result(doc: dict, flags: StationFlags, verdict: str | None, *, kind: s
 
     unit = doc.get("unit") or {}
     hashes = [sha256_of(p) for p in inputs if p is not None]
-    store = open_store(flags.store)
-    try:
-        return store.add(serial=unit.get("serial") or flags.unit, kind=kind, document=doc, station=flags.station,
+    from datetime import datetime
+
+    created = datetime.fromisoformat(unit["created"].replace("Z", "+00:00")) if unit.get("created") else None
+    with open_store(flags.store) as store:
+        return store.add(unit.get("serial") or flags.unit, kind, doc, created=created, station=flags.station,
                          operator=flags.operator, verdict=verdict, input_sha256=hashes[0] if len(hashes) == 1 else hashes,
                          job=job, args=args)
-    finally:
-        store.close()
 
 
 def print_verdict(console, doc: dict) -> None:

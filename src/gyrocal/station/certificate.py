@@ -47,14 +47,22 @@ def _results(doc: dict) -> list[dict]:
 
 def _parameters(doc: dict) -> list[dict]:
     std = doc.get("std") or {}
-    found = {p["name"]: p for p in (doc.get("as_found") or {}).get("parameters", [])}
     internal = (doc.get("units") or {}).get("internal", "")
     rows = []
     for name, value in _flat_parameters(doc):
         unit = internal if name[0] in "bB" else "1"
-        rows.append({"name": name, "value": _num(value, 8), "sigma": _num(std.get(name), 3),
-                     "found": _num(found.get(name, {}).get("error")), "unit": unit})
+        rows.append({"name": name, "value": _num(value, 8), "sigma": _num(std.get(name), 3), "unit": unit})
     return rows
+
+
+def _found_left(doc: dict) -> list[dict]:
+    """Rows of the as-found / as-left table: each error with its 1-sigma, before and after adjustment."""
+    found, left = doc.get("as_found"), doc.get("as_left")
+    if not found or not left:
+        return []
+    return [{"name": f["name"].replace("_", " "), "found": _num(f["error"], 4), "found_sigma": _num(f["sigma"], 2),
+             "left": _num(g["error"], 4), "left_sigma": _num(g["sigma"], 2), "unit": f["unit"]}
+            for f, g in zip(found["parameters"], left["parameters"])]
 
 
 def _flat_parameters(doc: dict) -> list[tuple[str, float]]:
@@ -113,7 +121,8 @@ def _context(doc: dict, record: str) -> dict:
     verdict = "NO LIMITS" if acc is None else acc["verdict"].upper()
     return {"unit": unit, "identity": identity, "conditions": conditions, "verdict": verdict,
             "guard": _num((acc or {}).get("guard", 2)), "results": _results(doc), "parameters": _parameters(doc),
-            "as_found": bool(doc.get("as_found")), "picture": _picture(doc), "record": record,
+            "found_left": _found_left(doc),
+            "previous": (doc.get("as_found") or {}).get("created"), "picture": _picture(doc), "record": record,
             "issued": datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
             "methods": "the servo method of Wang et al. and the full-temperature-range method, as gyrocal implements them"}
 
