@@ -8,6 +8,8 @@ says the verdict (0 pass or no limits, 1 fail). Library imports happen inside th
 
 from __future__ import annotations
 
+import contextlib
+from contextvars import ContextVar
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Optional
@@ -19,6 +21,18 @@ from ..errors import InputError
 __all__ = ["STATION", "StationFlags", "finish", "print_verdict", "store_result"]
 
 _PANEL = "Production station"
+#: (job, args) of a batch row being run: recorded with the result, so that a rerun of the batch finds it
+BATCH_JOB: ContextVar[tuple[str, str] | None] = ContextVar("batch_job", default=None)
+
+
+@contextlib.contextmanager
+def batch_job(job: str, args: str):
+    """Record the results made inside as the batch job `job` with flags `args`."""
+    token = BATCH_JOB.set((job, args))
+    try:
+        yield
+    finally:
+        BATCH_JOB.reset(token)
 
 
 def _opt(flag: str, text: str, metavar: str = "TEXT"):
@@ -133,6 +147,7 @@ def store_result(doc: dict, flags: StationFlags, verdict: str | None, *, kind: s
     from datetime import datetime
 
     created = datetime.fromisoformat(unit["created"].replace("Z", "+00:00")) if unit.get("created") else None
+    job, args = BATCH_JOB.get() or (job, args)
     with open_store(flags.store) as store:
         return store.add(unit.get("serial") or flags.unit, kind, doc, created=created, station=flags.station,
                          operator=flags.operator, verdict=verdict, input_sha256=hashes[0] if len(hashes) == 1 else hashes,
