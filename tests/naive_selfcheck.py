@@ -1,10 +1,12 @@
 """The straightforward implementations that the calibration's fast paths replaced, kept as their reference.
 
-Each function here is the code gyrocal ran before the speed work (window by window, full-rate passes,
-one whole-recording array after another), unchanged but for imports. ``tests/test_fast_paths.py``
-compares the fast paths with them on seeded data (equal to rounding), and ``bench/bench_selfcheck.py``
-times them as its naive baseline in the same process. :func:`install` swaps them into the library,
-so that a whole calibration runs the old way.
+Each function here reduces the way gyrocal did before the speed work (window by window, full-rate passes,
+one whole-recording array after another), on the plain re-implementations of ``tests/naive_reference.py``:
+nothing here calls gyrocal.longrun, gyrocal.timebase or gyrocal.timegaps (their TimeBase and Gap are only
+the containers :func:`analyse_time` fills for :func:`install`), so a slip in any of them shows as a
+difference. ``tests/test_fast_paths.py`` compares the fast paths with them on seeded data (equal to
+rounding), and ``bench/bench_selfcheck.py`` times them as its naive baseline in the same process.
+:func:`install` swaps them into the library, so that a whole calibration runs the old way.
 """
 
 from __future__ import annotations
@@ -15,17 +17,12 @@ from contextlib import contextmanager
 from types import MappingProxyType
 from typing import Any
 
+import naive_reference as ref
 import numpy as np
 
 from gyrocal._validation import finite_array, positive
 from gyrocal.errors import InputError
-from gyrocal.longrun import _design, block_means, find_lines, span_variance
 from gyrocal.observations import Observation
-from gyrocal.timebase import _LATE_EXTRA, _LATE_HOLD, TimeBase, _block_size, _fit_clock, nominal_period
-from gyrocal.timegaps import CANDIDATE_STEP as _CANDIDATE_STEP
-from gyrocal.timegaps import LATE_STEP as _LATE_STEP
-from gyrocal.timegaps import Gap
-from gyrocal.timegaps import least_delayed as _floor
 
 
 def _time_weights(t: np.ndarray, n: int) -> np.ndarray:
@@ -109,7 +106,7 @@ def fit_level(x, t, lines):
     if not lines:
         level = x.mean(axis=0)
         return level, 1.0 / len(x), x - level
-    X = _design(t, lines)
+    X = ref.design(t, lines)
     inv = np.linalg.inv(X.T @ X)
     coef = inv @ (X.T @ x)
     return coef[0], float(inv[0, 0]), x - X @ coef
@@ -125,8 +122,8 @@ def _pooled_lrv(residuals):
 def window_stats(rec, windows, reference, times, *, long_run, ripple):
     """Plateau levels and long-run variances, plateau by plateau (gyrocal.window_stats as it was)."""
     d = max(1, int(round(rec.sample_rate / 200.0)))
-    gyro = block_means(rec.gyro, d)
-    clock = block_means(np.asarray(times, dtype=float), d)
+    gyro = ref.block_means(rec.gyro, d)
+    clock = ref.block_means(np.asarray(times, dtype=float), d)
     span = {i: (-(-w.start // d), w.stop // d) for i, w in enumerate(windows)}
     blocks = {i: gyro[a:b] for i, (a, b) in span.items() if b - a >= 4}
     plateaus = [i for i in blocks if windows[i].kind == "rotation" and reference == "speed"]
@@ -135,7 +132,7 @@ def window_stats(rec, windows, reference, times, *, long_run, ripple):
     lines = []
     if ripple and plateaus:
         b = blocks[max(plateaus, key=lambda i: len(blocks[i]))]
-        lines = find_lines(b[:, int(np.argmax(np.abs(b.mean(axis=0))))])
+        lines = ref.find_lines(b[:, int(np.argmax(np.abs(b.mean(axis=0))))])
     out, resid, factor = {}, {}, {}
     for i in plateaus:
         t = clock[span[i][0]:span[i][1]]
@@ -144,7 +141,7 @@ def window_stats(rec, windows, reference, times, *, long_run, ripple):
         if ripple:
             out[i] = {"level": level}
     if long_run and plateaus:
-        a, b = span_variance([resid[i] for i in plateaus])
+        a, b = ref.span_variance([resid[i] for i in plateaus])
         for i in plateaus:
             out.setdefault(i, {})["mean_var"] = b * factor[i] + a * factor[i] ** 2
     if long_run and statics:
@@ -156,126 +153,109 @@ def window_stats(rec, windows, reference, times, *, long_run, ripple):
     return out
 
 
-# -- the time base (gyrocal.timebase as it was): whole-log arrays of steps and clock residuals --
+# -- the time base: whole-log arrays of steps and clock residuals, candidate gaps judged one by one --
 
 def _floors(r: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
     """The least-delayed sample of each block of `size` (the last one may be short): values and indices."""
-    m = len(r) // size
-    at = r[: m * size].reshape(m, size).argmin(axis=1) + np.arange(m) * size
-    if m * size < len(r):
-        at = np.append(at, m * size + int(np.argmin(r[m * size:])))
+    at = np.array([lo + int(np.argmin(r[lo:lo + size])) for lo in range(0, len(r), size)])
     return r[at], at
 
 
-def _find_gaps(r: np.ndarray, step: np.ndarray, period: float, floor: np.ndarray, size: int) -> list[Gap]:
-    """Real gaps: long steps across which the lower envelope of the clock residual `r` rises for good.
+def _candidates(step: np.ndarray, period: float, floor: np.ndarray, size: int) -> list[int]:
+    """Long steps in the two blocks around each rise of the envelope by half a period: the longest
+    first (ties in time order), then the shorter ones in time order."""
+    n_steps = len(step)
+    rises = [b for b in range(len(floor) - 1) if floor[b + 1] - floor[b] >= 0.5 * period]
+    likely = sorted({i for b in rises for i in range(b * size, min(n_steps, (b + 2) * size))
+                     if step[i] > ref.CANDIDATE_STEP * period})
+    late = sorted((i for i in likely if step[i] >= ref.LATE_STEP * period), key=lambda i: -step[i])
+    return late + [i for i in likely if step[i] < ref.LATE_STEP * period]
 
-    Blocks whose least-delayed level (`floor`, blocks of `size`) rises by half a period over the
-    block before hold the candidates. Each long step there is confirmed by the least-delayed level
-    (a low quantile, so that a few delayed samples at a gap's edge do not count) just before and
-    just after it, with the gaps already found taken out: the longest steps first, then the shorter
-    ones in time order, so that a burst's long step right after a real gap is judged with that gap
-    removed. A step must also be long enough to hold the samples it lost (counting the delay of
-    the sample before it, which shortens the step).
-    """
-    rise = np.flatnonzero(np.diff(floor) >= 0.5 * period)
-    if not len(rise):
-        return []
-    candidates = np.flatnonzero(step > _CANDIDATE_STEP * period)
-    lo = np.searchsorted(candidates, rise * size)
-    hi = np.searchsorted(candidates, (rise + 2) * size)
-    likely = np.unique(np.concatenate([candidates[a:b] for a, b in zip(lo, hi)]))
-    long_first = likely[step[likely] >= _LATE_STEP * period]
-    order = np.concatenate([long_first[np.argsort(-step[long_first], kind="stable")],
-                            likely[step[likely] < _LATE_STEP * period]])
+
+def _find_gaps(r: np.ndarray, step: np.ndarray, period: float, floor: np.ndarray, size: int) -> list[tuple]:
+    """Real gaps ``(index, step, lost)``: each candidate step judged, in order, on the least-delayed level
+    of the `size` samples up to it and from the sample after it, with the gaps found so far taken out;
+    a gap when that level rises by whole periods, no more of them than the step (lengthened by the delay
+    of the sample before it, which shortens it) can hold."""
     n = len(r)
     lost_at = np.zeros(n)  # samples lost just before each sample, as found so far
-    for i in order.tolist():
+    for i in _candidates(step, period, floor, size):
         lo, hi = max(0, i - size + 1), min(n, i + 1 + size)
         adj = r[lo:hi] - period * np.cumsum(lost_at[lo:hi])  # levels relative within the window
-        before = _floor(adj[: i + 1 - lo])
-        lost = int(np.rint((_floor(adj[i + 1 - lo:]) - before) / period))
-        # the step from a late sample is short by that sample's delay: count it in the room
+        before = ref.least_delayed(adj[: i + 1 - lo])
+        lost = int(np.rint((ref.least_delayed(adj[i + 1 - lo:]) - before) / period))
         room = int(np.rint((step[i] + max(0.0, adj[i - lo] - before)) / period))
         if 1 <= lost <= room:
             lost_at[i + 1] = lost
-    found = np.flatnonzero(lost_at)
-    return [Gap(int(j), float(step[j - 1]), int(lost_at[j])) for j in found]
+    return [(int(j), float(step[j - 1]), int(lost_at[j])) for j in np.flatnonzero(lost_at)]
 
 
-def analyse_time(t, *, has_time: bool = True) -> TimeBase:
-    """Read the time base of stamps `t` [s] (strictly increasing).
-
-    Parameters
-    ----------
-    t : array_like, shape (N,)
-        Sample times [s].
-    has_time : bool
-        Whether the stamps came from the data; a time base built from a declared rate is
-        regular but may still hold gaps (rows dropped for saturation).
-    """
+def time_facts(t, *, has_time: bool = True) -> dict:
+    """The facts of gyrocal.timebase.TimeBase for stamps `t`, as a dict (gaps as ``(index, step, lost)``)."""
     t = np.asarray(t, dtype=float)
     if t.ndim != 1 or len(t) < 2:
         raise InputError(f"a time base needs at least two sample times, got shape {t.shape}")
-    step = np.diff(t)
-    period = nominal_period(t)
-    # up to 20 000 evenly spread steps for the median and the jitter: exact enough, and cheap on long logs
-    sample = step[np.linspace(0, len(step) - 1, min(len(step), 20_000)).astype(np.intp)]
-    regular = float(step.max() - step.min()) <= 1e-9 * period * len(t)  # a clock's own stamps, up to rounding
-    gaps: list[Gap] = []
-    clock = (float(t[0]), float(t[-1] - t[0]) / (len(t) - 1))
+    n, step = len(t), np.diff(t)
+    period = ref.nominal_period(t)
+    # the documented even spread of up to 20 000 steps for the median and the jitter
+    spread = np.linspace(0, n - 2, min(n - 1, 20_000)).astype(np.intp)
+    regular = float(step.max() - step.min()) <= 1e-9 * period * n  # a clock's own stamps, up to rounding
+    gaps: list[tuple] = []
+    clock = (float(t[0]), float(t[-1] - t[0]) / (n - 1))
     if not regular:
-        r = t - t[0] - period * np.arange(len(t))  # clock residual; its lower envelope: the least-delayed samples
-        size = _block_size(period, len(t))
-        floor, at = _floors(r, size)
+        r = t - t[0] - period * np.arange(n)  # clock residual; its lower envelope: the least-delayed samples
+        size = ref.block_size(period, n)
+        floor, k = _floors(r, size)
         gaps = _find_gaps(r, step, period, floor, size)
-        k = None
         if gaps:  # the envelope again, with the lost samples counted (a block may straddle a gap)
-            lost = np.zeros(len(t))
-            for g in gaps:
-                lost[g.index] = g.lost
+            lost = np.zeros(n)
+            for index, _, gone in gaps:
+                lost[index] = gone
             lost = np.cumsum(lost)
             floor, at = _floors(r - period * lost, size)
             k = at + lost[at]
-        clock = _fit_clock(t, period, floor, at if k is None else k)
-        if gaps:
-            keep = np.ones(len(sample), dtype=bool)
-            keep[np.isin(np.linspace(0, len(step) - 1, len(sample)).astype(np.intp), [g.index - 1 for g in gaps])] = 0
-            sample = sample[keep] if keep.any() else sample
-    return TimeBase(
-        n=len(t),
-        span=float(t[-1] - t[0]),
-        period=period,
-        mean_step=float(t[-1] - t[0]) / (len(t) - 1),
-        median_step=float(np.median(sample)),
-        jitter=float(sample.std()) if len(sample) > 1 else 0.0,
-        delayed=_late(step, sample, period, gaps),
-        gaps=tuple(gaps),
-        has_time=has_time,
-        regular_clock=clock is not None,
-        clock_start=clock[0] if clock else float(t[0]),
-        clock_period=clock[1] if clock else period,
-    )
+        clock = ref.fit_clock(float(t[0]), period, floor, k)
+    across = {index - 1 for index, _, _ in gaps}  # the gaps' own steps are left out of the spread
+    sample = np.array([step[j] for j in spread if int(j) not in across]) if len(across) else step[spread]
+    sample = sample if len(sample) else step[spread]
+    mean = float(sample.sum()) / len(sample)
+    return {
+        "n": n, "span": float(t[-1] - t[0]), "period": period, "mean_step": float(t[-1] - t[0]) / (n - 1),
+        "median_step": ref.median(sample),
+        "jitter": math.sqrt(float(np.sum((sample - mean) ** 2)) / len(sample)) if len(sample) > 1 else 0.0,
+        "delayed": _late(step, sample, period, gaps), "gaps": tuple(gaps), "has_time": has_time,
+        "regular_clock": clock is not None, "clock_start": clock[0] if clock else float(t[0]),
+        "clock_period": clock[1] if clock else period,
+    }
 
 
 def _late(step, sample, period, gaps) -> int:
-    """Long steps beyond the packets' own step that lost nothing, counted over the whole step array."""
-    packet = float(np.median(sample[sample > 0.5 * period])) if np.any(sample > 0.5 * period) else period
-    limit = max(_LATE_STEP * period, packet + max(_LATE_EXTRA * period, _LATE_HOLD))
-    return int(np.count_nonzero(step > limit)) - sum(g.step > limit for g in gaps)
+    """Long steps that lost nothing, longer than 3 periods and than the packets' own step (the median sampled
+    step over half a period) plus the larger of 2 periods and 10 ms."""
+    packets = sample[sample > 0.5 * period]
+    packet = ref.median(packets) if len(packets) else period
+    limit = max(ref.LATE_STEP * period, packet + max(ref.LATE_EXTRA * period, ref.LATE_HOLD))
+    return int(np.count_nonzero(step > limit)) - sum(1 for _, s, _ in gaps if s > limit)
+
+
+def analyse_time(t, *, has_time: bool = True):
+    """:func:`time_facts` in the library's container (for :func:`install`: the pipeline reads a TimeBase)."""
+    from gyrocal.timebase import TimeBase
+    from gyrocal.timegaps import Gap
+
+    facts = time_facts(t, has_time=has_time)
+    return TimeBase(**{**facts, "gaps": tuple(Gap(*g) for g in facts["gaps"])})
 
 
 # -- the calibration's other pieces as they were --
 
 def _spread_blocks(gyro: np.ndarray, sample_rate: float, most: int = 200) -> np.ndarray:
-    """Up to `most` whole blocks of :data:`gyrocal.observed.QUIET_BLOCK` seconds, evenly spread over `gyro`.
+    """Up to `most` whole blocks of half a second (:data:`gyrocal.observed.QUIET_BLOCK`), evenly spread over `gyro`.
 
     The quiet-noise level is a pooled standard deviation of quiet blocks: two hundred of them
     give it to a fraction of a per cent, for a fraction of the work on a long log.
     """
-    from gyrocal.observed import QUIET_BLOCK
-
-    size = max(8, int(round(QUIET_BLOCK * sample_rate)))
+    size = max(8, int(round(0.5 * sample_rate)))  # gyrocal.observed.QUIET_BLOCK = 0.5 s
     blocks = len(gyro) // size
     if blocks <= most:
         return gyro

@@ -1,22 +1,28 @@
-"""The calibration's fast paths give what the straightforward code gave, to rounding.
+"""The calibration's fast paths give what the straightforward code gives, to rounding.
 
-Reference: ``tests/naive_selfcheck.py``, the implementations the fast paths replaced (window by window,
-whole-log arrays), run on the same seeded data. Tolerances: sums taken in another order differ by a few
-units in the last place, relative 1e-15 per sum, so window reductions are held to 1e-12; the time base's
-decisions (gaps, lost samples, late deliveries, the clock) must be identical. Where the fast path uses what
-is exact on a regular clock (even trapezoid weights, block centres a whole step apart) the straightforward
-path used rebuilt clock times whose steps carry their own rounding (relative 1e-10 at 1000 s): window means
-then agree to ~1e-12 and a fit's residuals, a difference of such means over a noise sigma of 6e-4 of them,
-to ~1e-8 noise sigmas; those comparisons allow 1e-9 relative and 1e-6 sigma.
+Reference: ``tests/naive_selfcheck.py`` (window by window, whole-log arrays, candidate gaps judged one by
+one) on ``tests/naive_reference.py`` (plain code written from the documented behaviour: medians and
+quantiles by sorting, least squares on designs built column by column, a line by centred sums). Neither calls a
+function of gyrocal.longrun, gyrocal.timebase or gyrocal.timegaps, so a slip in any of them shows here;
+run on the same seeded data. Tolerances: sums taken in another order differ by a few units in the last
+place, relative 1e-15 per sum, so window reductions are held to 1e-12; the time base's decisions (gaps,
+lost samples, late deliveries, a regular clock) must be identical, and its times (a difference, median,
+spread or line fit of stamps each rounded to eps |t|) agree within 4 eps max|t|. Where the fast path uses
+what is exact on a regular clock (even trapezoid weights, block centres a whole step apart) the
+straightforward path used rebuilt clock times whose steps carry their own rounding (relative 1e-10 at
+1000 s): window means then agree to ~1e-12 and a fit's residuals, a difference of such means over a noise
+sigma of 6e-4 of them, to ~1e-8 noise sigmas; those comparisons allow 1e-9 relative and 1e-6 sigma.
 """
 
+import dataclasses
 import math
 
+import naive_reference as ref
 import naive_selfcheck as naive
 import numpy as np
 import pytest
 
-from gyrocal.longrun import fit_level, fit_levels, newey_west_var
+from gyrocal.longrun import block_means, find_lines, fit_level, fit_levels, newey_west_var, span_variance
 from gyrocal.models import ScaleBias
 from gyrocal.moments import window_moments
 from gyrocal.observations import observe
@@ -53,10 +59,10 @@ def _stamps(session, kind, rng):
 
 @pytest.mark.parametrize("kind", ["sensor", "receive", "late", "gaps", "sensor gaps"])
 def test_time_base_is_the_same(session, kind, rng):
-    """Every fact and decision of the time base, exactly (stamps as logged and rounded to microseconds)."""
+    """Every decision of the time base exactly, its times to rounding (stamps as logged and rounded to microseconds)."""
     t = _stamps(session, kind, rng).t
     for stamps in (t, np.round(t, 6)):
-        assert analyse_time(stamps) == naive.analyse_time(stamps)
+        _same_time_base(_facts(analyse_time(stamps)), naive.time_facts(stamps), stamps)
     if kind in ("gaps", "sensor gaps"):
         assert analyse_time(t).gaps, "the gaps were meant to be found"
 
@@ -65,11 +71,153 @@ def test_time_base_of_short_logs_and_gaps_near_the_ends(rng):
     """Logs shorter than a block of the envelope, and gaps within a window's length of either end."""
     for n in (2, 3, 40, 130, 1200):
         t = np.cumsum(rng.uniform(0.5, 1.5, n)) * 1e-3
-        assert analyse_time(t) == naive.analyse_time(t)
+        _same_time_base(_facts(analyse_time(t)), naive.time_facts(t), t)
     t = np.arange(5000) * 1e-3 + rng.uniform(0, 3e-4, 5000)
     for at in (3, 60, 4950, 4990):
         gappy = np.concatenate([t[:at], t[at:] + 0.02])
-        assert analyse_time(gappy) == naive.analyse_time(gappy)
+        # near the start a gap (its decision compared); in the envelope's last block, a late delivery
+        assert (len(analyse_time(gappy).gaps), analyse_time(gappy).delayed) == ((1, 0) if at < 100 else (0, 1))
+        _same_time_base(_facts(analyse_time(gappy)), naive.time_facts(gappy), gappy)
+
+
+def _delivered(n: int, period: float, rng, *, pattern=(1.0,), late_step=None, gap_step=None) -> np.ndarray:
+    """A sensor clock delivered in steps repeating `pattern` [periods, mean 1] with 0.1 % of a period of
+    jitter, and at sample n / 2 either a late delivery (a step `late_step` long, the samples it held back
+    caught up at once: nothing lost) or a gap of one sample spread over three steps (the two samples before
+    it delayed), the first and last `gap_step` periods, the middle one ~1."""
+    t = np.concatenate([[0.0], np.cumsum(np.resize(pattern, n - 1))]) * period + rng.uniform(0, 1e-3 * period, n)
+    j = n // 2
+    if late_step is not None:
+        end = t[j - 1] + late_step
+        held = int(np.searchsorted(t, end + 1e-3 * period)) - j  # the samples due before the late one arrives
+        t[j:j + held] = end + 1e-6 * period * np.arange(held)
+    if gap_step is not None:
+        t[j:] += period
+        t[j - 2] += (gap_step - 1) * period
+        t[j - 1] += (2 - gap_step) * period
+    return t
+
+
+#: Packets 0.55 and 1.75 periods apart (the packets' step, their median, 0.55: 3 periods is then the limit alone),
+#: eight to a cycle so that every 64-step block of the nominal period holds whole cycles.
+_BURSTS = (0.55, 1.75, 0.55, 0.55, 1.75, 0.55, 0.55, 1.75)
+
+
+@pytest.mark.parametrize("case", ["late 1 kHz", "late 100 Hz", "late 100 Hz bursts", "gap step"])
+def test_time_base_either_side_of_its_documented_limits(case, rng):
+    """Steps 0.5 % either side of the late-delivery limit, max(3 periods, packet step + max(2 periods, 10 ms))
+    (at 1 kHz the 10 ms decide, at 100 Hz the periods), and a one-sample gap's steps either side of 1.5 periods
+    (shorter ones are not examined): the reference's restated constants decide as the library's, and as the
+    documentation says."""
+    period = 1e-2 if "100 Hz" in case else 1e-3
+    pattern = _BURSTS if "bursts" in case else (1.0,)
+    packet = float(np.median([p for p in pattern if p > 0.5])) * period
+    limit = max(3 * period, packet + max(2 * period, 0.01))
+    for side in (1.005, 0.995):
+        if case == "gap step":
+            t, want = _delivered(3000, period, rng, gap_step=1.5 * side), ((1, 0) if side > 1 else (0, 0))
+        else:
+            t = _delivered(3000, period, rng, pattern=pattern, late_step=limit * side)
+            want = (0, 1) if side > 1 else (0, 0)
+        fast = analyse_time(t)
+        assert (len(fast.gaps), fast.delayed) == want
+        _same_time_base(_facts(fast), naive.time_facts(t), t)
+
+
+def test_time_base_gap_judged_on_the_tenth_quantile(rng):
+    """A gap of three samples ten samples from the start, after the rest of those ten delayed by 0.8 period: the
+    level before it is the tenth quantile of the ten (the second lowest). With two on time, all three lost
+    samples are counted there; with one, that one is passed over, two are counted there, and the step after the
+    one on time (1.8 periods, judged after the longer one) takes the third."""
+    period = 1e-3
+    for on_time, gaps in ((2, [(10, 3)]), (1, [(1, 1), (10, 2)])):
+        t = np.arange(5000) * period + rng.uniform(0, 1e-3 * period, 5000)
+        t[on_time:10] += 0.8 * period
+        t[10:] += 3 * period
+        fast = analyse_time(t)
+        assert [(g.index, g.lost) for g in fast.gaps] == gaps
+        _same_time_base(_facts(fast), naive.time_facts(t), t)
+
+
+def test_time_base_regular_clock_either_side_of_half_a_period(rng):
+    """Delays rising as a tent across the log (no gap, no long step), of heights 0.5 % either side of the one
+    at which the reference's envelope stops fitting a line within half a period: a regular clock, then not."""
+    period, n = 1e-3, 6000
+    jitter = rng.uniform(0, 1e-3 * period, n)
+
+    def stamps(height: float) -> np.ndarray:
+        return np.arange(n) * period + jitter + height * period * (1 - np.abs(2 * np.arange(n) / (n - 1) - 1))
+
+    lo, hi = 0.3, 0.7
+    for _ in range(30):  # bisection for the height where the reference's decision turns
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if naive.time_facts(stamps(mid))["regular_clock"] else (lo, mid)
+    for side, regular in ((1.005, False), (0.995, True)):
+        t = stamps(hi * side)
+        fast = analyse_time(t)
+        assert (fast.regular_clock, fast.gaps, fast.delayed) == (regular, (), 0)
+        _same_time_base(_facts(fast), naive.time_facts(t), t)
+
+
+def test_ripple_lines_span_variance_and_block_means(rng):
+    """The library's line search, span variance and block means against the plain loops of
+    ``tests/naive_reference.py`` (its own taper, padding and bins; span sums and block means of its own)."""
+    n = 2400
+    k = np.arange(n)
+    y = 0.05 * np.sin(2 * np.pi * 0.0125 * k + 0.3) + 0.02 * np.cos(2 * np.pi * 0.031 * k) + rng.normal(0, 0.03, n)
+    got, want = find_lines(y), ref.find_lines(y)
+    assert len(want) == 2
+    # bins are 1 / (4 n) = 1e-4 apart; the two spectra agree to 1e-15 of their peak, the lines far closer than this
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-12)
+    # white noise (b only), with a bounded vibration (a and b), differenced (a only)
+    residuals = []
+    for m in (800, 1000, 1300):
+        e = rng.normal(size=(m + 1, 3))
+        r = np.column_stack([e[1:, 0], e[1:, 1] + 2 * np.sin(0.7 * np.arange(m)), np.diff(e[:, 2])])
+        residuals.append(r - r.mean(axis=0))
+    for got, want in zip(span_variance(residuals), ref.span_variance(residuals)):
+        # sums over up to 266 rows (relative 1e-14) through a two-term fit of condition below 1e3
+        np.testing.assert_allclose(got, want, rtol=1e-10, atol=0)
+    x = rng.normal(size=(1003, 3))
+    for d in (1, 5, 7):
+        for v in (x, x[:, 1], np.asfortranarray(x)):
+            np.testing.assert_allclose(block_means(v, d), ref.block_means(v, d), rtol=1e-13, atol=1e-15)
+
+
+def test_ripple_line_either_side_of_its_threshold(rng):
+    """A line standing 0.05 % above, then below, 25 times the background (median / ln 2 of the bins with a whole
+    cycle or more in the window) of the reference's periodogram: found, then not, by the library too."""
+    n = 400
+    noise, wave = rng.normal(size=n), np.sin(2 * np.pi * 0.1 * np.arange(n) + 0.4)
+
+    def ratio(a: float) -> float:
+        spec = ref.periodogram(noise + a * wave)[4:]  # bin j has j / 4 cycles in the window
+        return float(spec.max() / (ref.median(spec) / math.log(2.0)))
+
+    for side, want in ((1.0005, 1), (0.9995, 0)):
+        lo, hi = 0.0, 2.0
+        for _ in range(50):  # bisection for the amplitude whose peak is `side` times the threshold
+            lo, hi = ((lo + hi) / 2, hi) if ratio((lo + hi) / 2) < 25 * side else (lo, (lo + hi) / 2)
+        y = noise + hi * wave
+        assert len(find_lines(y, max_lines=1)) == len(ref.find_lines(y, max_lines=1)) == want
+
+
+def _facts(tb) -> dict:
+    """A TimeBase's fields, its gaps as ``(index, step, lost)`` (the reference's own form)."""
+    facts = dataclasses.asdict(tb)
+    facts["gaps"] = tuple((g["index"], g["step"], g["lost"]) for g in facts["gaps"])
+    return facts
+
+
+_TIMES = ("span", "period", "mean_step", "median_step", "jitter", "clock_start", "clock_period")
+
+
+def _same_time_base(fast: dict, slow: dict, t) -> None:
+    """Counts, decisions and gaps (a gap's step is the same subtraction) exactly; the times to 4 eps max|t|."""
+    assert {k: v for k, v in fast.items() if k not in _TIMES} == {k: v for k, v in slow.items() if k not in _TIMES}
+    tol = 4 * np.finfo(float).eps * float(np.max(np.abs(t)))
+    for name in _TIMES:
+        assert fast[name] == pytest.approx(slow[name], rel=0, abs=tol), name
 
 
 @pytest.mark.parametrize("order", ["C", "F"])
@@ -138,17 +286,20 @@ def test_calibration_is_the_same(session, kind, reference, rng, monkeypatch):
         with monkeypatch.context() as m:
             naive.install(m)
             slow = calibrate(rec, **ref, **kw)
-        _same_calibration(fast, slow)
+        _same_calibration(fast, slow, rec.t)
 
 
-def _same_calibration(fast, slow):
+def _same_calibration(fast, slow, t):
     a, b = fast.calibration, slow.calibration
     assert _close_documents(list(a.windows), list(b.windows))  # an angle's rate: the duration to rounding
     np.testing.assert_allclose(a.model.params, b.model.params, rtol=1e-9)
     scale = np.sqrt(np.outer(np.diag(b.covariance), np.diag(b.covariance)))
     np.testing.assert_allclose(a.covariance / scale, b.covariance / scale, atol=1e-9)
     np.testing.assert_allclose(a.noise_std, b.noise_std, rtol=1e-9)
-    assert (fast.warnings, fast.notes, fast.time_base) == (slow.warnings, slow.notes, slow.time_base)
+    assert (fast.warnings, fast.notes) == (slow.warnings, slow.notes)
+    assert (fast.time_base is None) == (slow.time_base is None)
+    if fast.time_base is not None:
+        _same_time_base(_facts(fast.time_base), _facts(slow.time_base), t)
     assert (a.observed is None) == (b.observed is None) and (a.fit is None) == (b.fit is None)
     if a.fit is not None:
         fa, fb = a.fit.to_document(), b.fit.to_document()
