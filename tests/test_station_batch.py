@@ -10,8 +10,8 @@ import math
 import time
 
 import pytest
-
 from cli_runner import invoke, refused
+
 from gyrocal.store import open_store
 
 SPEED = "--units deg/s --speed 60"

@@ -129,7 +129,7 @@ def find_lines(y: np.ndarray, *, max_lines: int = 3, threshold: float = 25.0, mi
     resid = y - y.mean()
     for _ in range(max_lines):
         f, spec = _periodogram(resid)
-        usable = f * n >= min_cycles
+        usable = f * n >= min_cycles - 1e-9  # rfftfreq's bin of exactly one cycle can land an ulp short
         if not usable.any():
             break
         background = np.median(spec[usable]) / np.log(2.0)
