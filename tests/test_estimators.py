@@ -106,6 +106,12 @@ def test_closed_form_equals_levenberg_marquardt(rng):
     np.testing.assert_allclose(fast.covariance, slow.covariance, rtol=1e-9, atol=0)
     np.testing.assert_allclose(fast.residuals, 0, atol=1e-10)
     np.testing.assert_array_equal(fast.history[:, -1], fast.params)
+    # and the closed form solved every item itself (its fallback to LM would hide an error in it)
+    from gyrocal.estimators._exact6 import exact_six
+
+    solved = exact_six(obs.mean, obs.rate, obs.count, None, obs.noise_var)
+    assert solved[4].all()
+    np.testing.assert_allclose(np.hstack([solved[0], solved[1]]), slow.params, rtol=0, atol=1e-12)
 
 
 def test_closed_form_falls_back_for_items_it_cannot_solve(rng, monkeypatch):

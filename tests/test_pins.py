@@ -9,9 +9,11 @@ from scipy.stats import chi2, multivariate_normal, norm
 from scipy.stats import t as student_t
 
 from gyrocal import excess, units
+from gyrocal.estimators import FirstMoment
 from gyrocal.flight.polyfit import choose_orders
 from gyrocal.models import ScaleBias
 from gyrocal.noise.figures import read_figures
+from gyrocal.observations import ObservationSet
 from gyrocal.pipeline import calibrate
 from gyrocal.recording import Recording
 from gyrocal.screening import screen_gaps
@@ -154,3 +156,38 @@ def test_bias_instability_is_the_flat_floor_over_0664():
     bias = read_figures(taus, np.tile(adev, (3, 1)), fs, n, level=0.683)[2]
     expected = adev[i_min] / math.sqrt(2 * math.log(2) / math.pi)
     np.testing.assert_allclose(bias.value[:3], expected, rtol=1e-12)
+
+
+# --- the first-moment covariance with measured window-mean variances: generalised least squares ---
+
+
+def test_measured_mean_variances_give_the_gls_covariance():
+    """Reference: (J^T V^-1 J)^-1 of generalised least squares, with J by central differences of the row model
+    written here (turn rows |diag(k)(m + b)| - rate, static rows k_j (m_j + b_j)) and V from the given variances
+    of the window means; noise-free means, so the fit sits at the truth and its weights are exact."""
+    k, b = np.array([1.01, 0.99, 1.002]), np.array([0.02, -0.01, 0.005])
+    rate = 1.0
+    axes = np.repeat(np.eye(3), 2, axis=0) * np.tile([1.0, -1.0], 3)[:, None]  # +-x, +-y, +-z
+    means = np.vstack([axes * rate / k - b, -b, -b])  # six turns, then two static windows
+    static = np.array([False] * 6 + [True] * 2)
+    count = np.full(8, 2000.0)
+    mean_var = np.random.default_rng(8).uniform(0.5e-8, 2e-8, (8, 3))  # [rad^2/s^2], one per window and axis
+    noise_var = np.full((8, 3), 1e-4)
+    obs = ObservationSet(means[None], (means**2 + noise_var)[None], noise_var[None],
+                         np.where(static, 0.0, rate)[None], count, count / 200.0, static, mean_var=mean_var[None])
+    fit = FirstMoment().fit(obs)
+    np.testing.assert_allclose(fit.model.params, np.concatenate([k, b]), atol=1e-12)
+
+    def rows(p):
+        kk, bb = p[:3], p[3:]
+        turns = [np.linalg.norm(kk * (m + bb)) - rate for m in means[:6]]
+        return np.concatenate([turns, *[kk * (m + bb) for m in means[6:]]])
+
+    p = np.concatenate([k, b])
+    h = 1e-6
+    J = np.stack([(rows(p + h * e) - rows(p - h * e)) / (2 * h) for e in np.eye(6)], axis=1)
+    u = [k * (m + b) / np.linalg.norm(k * (m + b)) for m in means[:6]]
+    var = np.concatenate([[np.sum((k * u[i]) ** 2 * mean_var[i]) for i in range(6)],
+                          *[k**2 * mean_var[i] for i in (6, 7)]])
+    gls = np.linalg.inv(J.T @ (J / var[:, None]))
+    np.testing.assert_allclose(fit.covariance, gls, rtol=1e-6, atol=1e-9 * np.diag(gls).min())
