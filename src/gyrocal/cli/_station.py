@@ -9,6 +9,7 @@ says the verdict (0 pass or no limits, 1 fail). Library imports happen inside th
 from __future__ import annotations
 
 import contextlib
+import functools
 from contextvars import ContextVar
 from dataclasses import dataclass
 from pathlib import Path
@@ -120,13 +121,23 @@ def finish(doc: dict, flags: StationFlags, *, inputs, device_id: int | None = No
     return doc, verdict
 
 
+@functools.cache
+def opened_store(url: str):
+    """The store at `url`, opened once per process (a batch worker calibrates many units) and closed at exit."""
+    import atexit
+
+    from ..store import open_store
+
+    store = open_store(url)
+    atexit.register(store.close)
+    return store
+
+
 def _with_as_found(doc: dict, flags: StationFlags) -> dict:
     """`doc` with ``as_found``/``as_left`` when the store holds a calibration of the unit in force now."""
     from ..station.asfound import as_found_and_left
-    from ..store import open_store
 
-    with open_store(flags.store) as store:
-        previous = store.in_force(flags.unit)
+    previous = opened_store(flags.store).in_force(flags.unit)
     if previous is None:
         return doc
     parts = as_found_and_left(doc, previous.document, record=previous.id,
@@ -140,7 +151,6 @@ def store_result(doc: dict, flags: StationFlags, verdict: str | None, *, kind: s
     if flags.store is None:
         return None
     from ..station.identity import sha256_of
-    from ..store import open_store
 
     unit = doc.get("unit") or {}
     hashes = [sha256_of(p) for p in inputs if p is not None]
@@ -148,10 +158,9 @@ def store_result(doc: dict, flags: StationFlags, verdict: str | None, *, kind: s
 
     created = datetime.fromisoformat(unit["created"].replace("Z", "+00:00")) if unit.get("created") else None
     job, args = BATCH_JOB.get() or (job, args)
-    with open_store(flags.store) as store:
-        return store.add(unit.get("serial") or flags.unit, kind, doc, created=created, station=flags.station,
-                         operator=flags.operator, verdict=verdict, input_sha256=hashes[0] if len(hashes) == 1 else hashes,
-                         job=job, args=args)
+    return opened_store(flags.store).add(unit.get("serial") or flags.unit, kind, doc, created=created,
+                                         station=flags.station, operator=flags.operator, verdict=verdict,
+                                         input_sha256=hashes[0] if len(hashes) == 1 else hashes, job=job, args=args)
 
 
 def print_verdict(console, doc: dict) -> None:

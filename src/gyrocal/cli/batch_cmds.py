@@ -99,7 +99,12 @@ def _run(todo, shas, url, limits, out_dir, jobs: int, store) -> list[Outcome]:
     from rich.progress import Progress
 
     outcomes = []
-    with ProcessPoolExecutor(max_workers=jobs) as pool, Progress(console=console, transient=True) as bar:
+    import multiprocessing
+
+    # spawned, not forked: a worker must not inherit this process's open store connections
+    context = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=jobs, mp_context=context) as pool, \
+            Progress(console=console, transient=True) as bar:
         task = bar.add_task("calibrating", total=len(todo))
         futures = {pool.submit(_run_row, _argv(r, url, limits, out_dir, shas[r.line]), r.job, r.args): r
                    for r in todo}

@@ -9,6 +9,8 @@ gyrocal does not know (written by a newer gyrocal) is refused before anything is
 
 from __future__ import annotations
 
+import functools
+
 from pathlib import Path
 
 from alembic import command
@@ -39,9 +41,16 @@ def _config(connection: Connection | None = None) -> Config:
     return config
 
 
-def known_revisions() -> set[str]:
+@functools.cache
+def _scripts() -> ScriptDirectory:
+    """The bundled migrations, read once per process (a store is opened for every unit of a batch)."""
+    return ScriptDirectory.from_config(_config())
+
+
+@functools.cache
+def known_revisions() -> frozenset[str]:
     """Every schema revision this gyrocal's migrations define."""
-    return {script.revision for script in ScriptDirectory.from_config(_config()).walk_revisions()}
+    return frozenset(script.revision for script in _scripts().walk_revisions())
 
 
 def current_revisions(connection: Connection) -> tuple[str, ...]:
@@ -53,7 +62,7 @@ def _migrate(connection: Connection, url: StoreURL) -> tuple[str, ...]:
     if connection.dialect.name == "postgresql":
         connection.execute(text("SELECT pg_advisory_xact_lock(:key)"), {"key": _PG_LOCK})
     current = current_revisions(connection)
-    script = ScriptDirectory.from_config(_config())
+    script = _scripts()
     unknown = [rev for rev in current if rev not in known_revisions()]
     if unknown:
         from .._version import __version__
