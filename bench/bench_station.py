@@ -76,7 +76,7 @@ def main(argv: list[str] | None = None) -> None:
     print(f"batch -j 2: {two:7.2f} s  {n / two:6.2f} sessions/s  ({one / two:.2f} x the baseline)")
     store_s, records = _store_part(folder / "one.db", folder / "replay.db")
     print(f"store part of a calibration: {store_s / records * 1e3:.1f} ms ({records} records: rerun check, "
-          f"as-found lookup, insert, each opening the store), {100 * store_s / one:.1f} % of the -j 1 batch")
+          f"as-found lookup, insert), {100 * store_s / one:.1f} % of the -j 1 batch")
     if options.keep is None:
         shutil.rmtree(folder)
 

@@ -10,7 +10,6 @@ gyrocal does not know (written by a newer gyrocal) is refused before anything is
 from __future__ import annotations
 
 import functools
-
 from pathlib import Path
 
 from alembic import command
