@@ -69,10 +69,11 @@ def test_extra_variance_is_the_root_of_chi2_equals_dof():
 
 @pytest.mark.parametrize("side, flagged", [(0.95, True), (1.05, False)])
 def test_a_group_is_widened_only_below_p_one_tenth(side, flagged):
-    """Reference: chi2.isf from scipy at p = 0.1 (the evidence threshold), with 10 rows of zero leverage."""
-    n = 10
-    z2 = np.full(n, chi2.isf(0.1 * side, n) / n)  # the group's chi2 has p = 0.1 x side
-    h = np.zeros(n)
+    """Reference: chi2.isf from scipy at p = 0.1 (the evidence threshold), for 10 rows of leverage 0.3: the group
+    has 10 x (1 - 0.3) = 7 degrees of freedom (each row's leverage is the share of a parameter it takes)."""
+    n, dof = 10, 7.0
+    z2 = np.full(n, chi2.isf(0.1 * side, dof) / n)  # the group's chi2 has p = 0.1 x side
+    h = np.full(n, 0.3)
     out = excess._beyond_noise(z2, h, n, np.zeros(0, dtype=int))
     assert bool(out[0]) is flagged
 
