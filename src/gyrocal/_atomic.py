@@ -16,7 +16,7 @@ import threading
 from pathlib import Path
 from typing import Iterator
 
-__all__ = ["atomic_path", "write_text_atomic", "Terminated"]
+__all__ = ["atomic_folder", "atomic_path", "write_text_atomic", "Terminated"]
 
 _SIGNALS = tuple(getattr(signal, name) for name in ("SIGTERM", "SIGHUP") if hasattr(signal, name))
 
@@ -98,3 +98,31 @@ def write_text_atomic(path: str | os.PathLike, text: str) -> None:
     """Write `text` to `path` atomically (UTF-8)."""
     with atomic_path(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
+
+
+@contextlib.contextmanager
+def atomic_folder(path: str | os.PathLike) -> Iterator[Path]:
+    """Yield an empty temporary folder beside `path`; when the block succeeds, move each file written in it
+    into `path` (created if need be), replacing only those names there, the ones named ``*.md`` last.
+
+    A block that fails (or a terminating signal) leaves `path` as it was and no temporary behind.
+    """
+    import shutil
+
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    with _cleanup_on_signals():
+        while True:
+            tmp = target.parent / f".{target.name}.{secrets.token_hex(4)}.tmp"
+            try:
+                tmp.mkdir()
+                break
+            except FileExistsError:
+                continue
+        try:
+            yield tmp
+            target.mkdir(exist_ok=True)
+            for item in sorted(tmp.iterdir(), key=lambda p: (p.suffix == ".md", p.name)):
+                os.replace(item, target / item.name)
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)

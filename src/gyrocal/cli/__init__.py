@@ -18,10 +18,11 @@ __all__ = ["COMMAND_MODULES", "HELP_ORDER", "app", "main"]
 #: Modules that register commands (add yours here).
 COMMAND_MODULES = ("calibrate_cmds", "imu_cmds", "apply_cmds", "export_cmds", "thermal_cmds", "noise_cmds",
                    "flight_cmds", "sim_cmds", "plan_cmds", "study_cmds", "capture_cmds", "verify_cmds",
-                   "station_cmds", "store_cmds", "batch_cmds")
+                   "station_cmds", "store_cmds", "batch_cmds", "fleet_cmds")
 #: Order of the commands in ``gyrocal --help``; commands not listed follow by name.
 HELP_ORDER = ("calibrate", "segments", "apply", "export", "imu", "verify", "compare", "thermal", "thermal-report",
-              "noise", "thermal-bias", "simulate", "plan", "study", "capture", "batch", "accept", "certificate", "store")
+              "noise", "thermal-bias", "simulate", "plan", "study", "capture", "batch", "accept", "certificate", "store",
+              "fleet")
 
 for _name in COMMAND_MODULES:
     importlib.import_module(f"{__name__}.{_name}")

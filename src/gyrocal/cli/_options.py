@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import math
+from datetime import datetime, timezone
 from typing import Annotated, Optional
 
 import typer
 
 from ..errors import InputError
 
-__all__ = ["NoiseDensity", "given", "noise_std", "numbers", "refuse_unused", "triple"]
+__all__ = ["NoiseDensity", "StoreUrl", "given", "iso_time", "noise_std", "numbers", "refuse_unused", "triple"]
 
 
 def given(ctx: typer.Context, name: str) -> bool:
@@ -109,3 +110,18 @@ def triple_in_unit(flag: str, text: str | None, unit: str, default) -> list[floa
         return list(default)
     raw, given_unit = _split_unit(flag, text)
     return [v * _RATE_UNITS[given_unit or unit] / _RATE_UNITS[unit] for v in triple(flag, raw, default)]
+
+
+StoreUrl = Annotated[str, typer.Option("--store", help="The store: an SQLite file (path or sqlite:///path) or "
+                                       "postgresql://user@host:port/db.", metavar="URL")]
+
+
+def iso_time(text: str | None, flag: str) -> datetime | None:
+    """ISO 8601 (``YYYY-MM-DDTHH:MM:SSZ``, or with an offset; a date alone is its midnight UTC)."""
+    if text is None:
+        return None
+    try:
+        when = datetime.fromisoformat(text.strip().replace("Z", "+00:00"))
+    except ValueError:
+        raise InputError(f"{flag} takes an ISO 8601 time such as 2026-12-02T13:45:00Z, got {text!r}") from None
+    return when.replace(tzinfo=timezone.utc) if when.tzinfo is None else when.astimezone(timezone.utc)

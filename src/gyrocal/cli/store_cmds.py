@@ -11,6 +11,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import InputError
+from ._options import StoreUrl, iso_time
 from ._outputs import check_output
 from .app import app, console
 
@@ -20,20 +21,7 @@ store_app = typer.Typer(help="Query the calibration store: history, the calibrat
                         no_args_is_help=True)
 app.add_typer(store_app, name="store")
 
-StoreUrl = Annotated[str, typer.Option("--store", help="The store: an SQLite file (path or sqlite:///path) or "
-                                       "postgresql://user@host:port/db.", metavar="URL")]
 Json = Annotated[bool, typer.Option("--json", help="Print a JSON array of records (with their documents).")]
-
-
-def _when(text: str | None, flag: str) -> datetime | None:
-    """ISO 8601 (``YYYY-MM-DDTHH:MM:SSZ``, or with an offset; a date alone is its midnight UTC)."""
-    if text is None:
-        return None
-    try:
-        when = datetime.fromisoformat(text.strip().replace("Z", "+00:00"))
-    except ValueError:
-        raise InputError(f"{flag} takes an ISO 8601 time such as 2026-12-02T13:45:00Z, got {text!r}") from None
-    return when.replace(tzinfo=timezone.utc) if when.tzinfo is None else when.astimezone(timezone.utc)
 
 
 def _record_json(r) -> dict:
@@ -101,7 +89,7 @@ def export(serial: Annotated[str, typer.Argument(help="The unit's serial number.
     """Write the calibration in force at a time: the newest passing one created at or before it."""
     from .._jsonfile import write_json
 
-    when = _when(at, "--at") or datetime.now(timezone.utc)
+    when = iso_time(at, "--at") or datetime.now(timezone.utc)
     with _open(store) as st:
         record = st.in_force(_serial(serial), when)
     if record is None:
@@ -124,7 +112,7 @@ def list_records(store: StoreUrl, since: Annotated[Optional[str], typer.Option(
     if verdict is not None and verdict not in ("pass", "fail"):
         raise InputError(f"--verdict takes pass or fail, got {verdict!r}")
     with _open(store) as st:
-        records = st.list(since=_when(since, "--since"), verdict=verdict)
+        records = st.list(since=iso_time(since, "--since"), verdict=verdict)
     if as_json:
         typer.echo(json.dumps([_record_json(r) for r in records], indent=1))
         return
