@@ -1,15 +1,18 @@
 """The station's flags, shared by every command that writes a result: identity, limits, store.
 
-:func:`finish` is the one ending of such a command: the result document gets its ``unit`` section
-and its acceptance, is written atomically, is stored as a new record, and the command's exit code
-says the verdict (0 pass or no limits, 1 fail). Library imports happen inside the functions, so
-``gyrocal --help`` stays fast.
+A command takes them with :func:`station_flags` (``--unit`` ... ``--store``, checked before its body
+runs) and ends in three calls: :func:`finish` gives the result document its ``unit`` section and its
+acceptance, :func:`write_and_store` writes it atomically (when the command has an output file) and
+adds it to the store, and :func:`conclude` says where it went and the verdict, with the exit code
+(0 pass or no limits, 1 fail). Library imports happen inside the functions, so ``gyrocal --help``
+stays fast.
 """
 
 from __future__ import annotations
 
 import contextlib
 import functools
+import inspect
 from contextvars import ContextVar
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,7 +22,8 @@ import typer
 
 from ..errors import InputError
 
-__all__ = ["STATION", "StationFlags", "finish", "print_verdict", "store_result"]
+__all__ = ["STATION", "StationFlags", "conclude", "finish", "print_verdict", "station_flags", "store_result",
+           "write_and_store"]
 
 _PANEL = "Production station"
 #: (job, args) of a batch row being run: recorded with the result, so that a rerun of the batch finds it
@@ -96,8 +100,39 @@ class StationFlags:
                         self.procedure)
 
 
+#: Parameter name -> option type, in the order of :class:`StationFlags`' fields.
+_PARAMETERS = {"unit": STATION.Unit, "part": STATION.Part, "revision": STATION.Revision, "station": STATION.Station,
+               "operator": STATION.Operator, "fixture": STATION.Fixture, "procedure": STATION.Procedure,
+               "limits": STATION.Limits, "store": STATION.Store}
+
+
+def station_flags(command):
+    """Give a command the station's flags: its command line takes ``--unit`` ... ``--store`` (after its own
+    options), and it is called with ``flags=`` the :class:`StationFlags` they make, already checked.
+
+    The command declares a last parameter ``flags: StationFlags = StationFlags()``; typer sees the
+    nine options in its place.
+    """
+    own = inspect.signature(command, eval_str=True)
+    if "flags" not in own.parameters:
+        raise TypeError(f"{command.__name__} takes no 'flags' parameter for the station's flags")
+    extra = [inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=None, annotation=kind)
+             for name, kind in _PARAMETERS.items()]
+    params = [p for p in own.parameters.values() if p.name != "flags"] + extra
+
+    @functools.wraps(command)
+    def with_flags(*args, **kwargs):
+        flags = StationFlags(**{name: kwargs.pop(name, None) for name in _PARAMETERS})
+        flags.check()
+        return command(*args, flags=flags, **kwargs)
+
+    with_flags.__signature__ = own.replace(parameters=params)
+    with_flags.__annotations__ = {p.name: p.annotation for p in params} | {"return": own.return_annotation}
+    return with_flags
+
+
 def finish(doc: dict, flags: StationFlags, *, inputs, device_id: int | None = None) -> tuple[dict, str | None]:
-    """Stamp `doc` with the unit and the acceptance; add it to the store. Returns the document and the verdict.
+    """Stamp `doc` with the unit, as found / as left (with --store) and the acceptance; the document and the verdict.
 
     The caller writes the returned document (atomically) before the store is written, so a stored
     record always has its file; the verdict is None without limits.
@@ -161,6 +196,28 @@ def store_result(doc: dict, flags: StationFlags, verdict: str | None, *, kind: s
     return opened_store(flags.store).add(unit.get("serial") or flags.unit, kind, doc, created=created,
                                          station=flags.station, operator=flags.operator, verdict=verdict,
                                          input_sha256=hashes[0] if len(hashes) == 1 else hashes, job=job, args=args)
+
+
+def write_and_store(doc: dict, flags: StationFlags, output: Path | None, verdict: str | None, *, inputs, kind: str,
+                    job: str, args: str = "") -> int | None:
+    """Write the finished `doc` to `output` atomically (None: nothing on disk), then add it to the store.
+
+    The file comes first, so a stored record always has its file; the record id, or None without --store.
+    """
+    if output is not None:
+        from .._jsonfile import write_json
+
+        write_json(output, doc)
+    return store_result(doc, flags, verdict, kind=kind, job=job, args=args, inputs=inputs)
+
+
+def conclude(console, doc: dict, flags: StationFlags, record: int | None, verdict: str | None) -> None:
+    """A command's last lines: where the record went, the acceptance; exit 1 when it failed."""
+    if record is not None:
+        console.print(f"stored as record {record} in {flags.store}", highlight=False)
+    print_verdict(console, doc)
+    if verdict == "fail":
+        raise typer.Exit(1)
 
 
 def print_verdict(console, doc: dict) -> None:

@@ -21,7 +21,7 @@ from ..errors import GyrocalError, InputError
 from ._outputs import check_output, same_document
 from ._reading import READING, read_from_flags, required_units
 from ._references import density_to_internal, noise_to_internal, rate_unit_of, reference_of
-from ._station import STATION, StationFlags, finish, print_verdict, store_result
+from ._station import StationFlags, conclude, finish, station_flags, write_and_store
 from .app import app, console, message, warn
 
 __all__ = ["calibrate", "segments"]
@@ -164,6 +164,7 @@ def _truth_calibration(path: Path, cal):
 
 
 @app.command()
+@station_flags
 def calibrate(
     recording: Annotated[Optional[Path], typer.Argument(help="Recording: CSV, Parquet, or a ROS/MCAP bag.")] = None,
     units: READING.Units = None,
@@ -196,22 +197,11 @@ def calibrate(
     example: Annotated[bool, typer.Option(
         "--example", help="Run on the bundled simulated MPU9250 servo recording (deg/s, --speed 60 unless "
         "--angle or --windows).")] = False,
-    unit: STATION.Unit = None,
-    part: STATION.Part = None,
-    revision: STATION.Revision = None,
-    station: STATION.Station = None,
-    operator: STATION.Operator = None,
-    fixture: STATION.Fixture = None,
-    procedure: STATION.Procedure = None,
-    limits: STATION.Limits = None,
-    store: STATION.Store = None,
+    flags: StationFlags = StationFlags(),
 ) -> None:
     """Estimate scale and bias from a recording of turns; print them with 1-sigma; write the calibration file."""
     # long function: the command's steps in order (flags, reading, fit, outputs, station), each a call of its own
     from ..pipeline import calibrate as run_calibration
-
-    flags = StationFlags(unit, part, revision, station, operator, fixture, procedure, limits, store)
-    flags.check()
 
     truth_path = None
     if example:
@@ -252,21 +242,13 @@ def calibrate(
 
         windows_used = [Window.from_dict(d) for d in cal.windows]
         _save_plot(plot, rec, windows_used, cal, speed_rad, f"{Path(recording).name}: {reference} reference")
-    if output is not None:
-        from .._jsonfile import write_json
-
-        write_json(output, doc)
-    record = store_result(doc, flags, verdict, kind="calibration", job="calibrate", args="", inputs=inputs)
+    record = write_and_store(doc, flags, output, verdict, inputs=inputs, kind="calibration", job="calibrate")
     if example:
         console.print(intro, highlight=False, soft_wrap=True)
     _print_calibration(run, None if truth_path is None else _truth_calibration(truth_path, cal))
     if output is not None:
         console.print(f"wrote {output}" + (f" and {plot}" if plot is not None else ""), highlight=False)
-    if record is not None:
-        console.print(f"stored as record {record} in {store}", highlight=False)
-    print_verdict(console, doc)
-    if verdict == "fail":
-        raise typer.Exit(1)
+    conclude(console, doc, flags, record, verdict)
 
 
 def _with_notes(cal, notes: list):

@@ -10,6 +10,7 @@ import typer
 
 from ._outputs import check_output, json_format
 from ._reading import READING, read_from_flags, required_units
+from ._station import StationFlags, conclude, finish, station_flags, write_and_store
 from .app import app, console
 
 __all__ = ["thermal_bias"]
@@ -46,6 +47,7 @@ def _summary(tb, unit: str, factor: float):
 
 
 @app.command("thermal-bias")
+@station_flags
 def thermal_bias(
     log: Annotated[Path, typer.Argument(help="Still log of a warming board: PX4 .ulg, ArduPilot .bin, CSV, ...")],
     output: Annotated[Optional[Path], typer.Option(
@@ -62,9 +64,9 @@ def thermal_bias(
         "--min-span", help="Smallest temperature span accepted [degC] (ArduPilot's minimum: 10).")] = 10.0,
     force: Annotated[bool, typer.Option("--force", help="Replace an -o file that is not a thermal-bias file.")]
     = False,
+    flags: StationFlags = StationFlags(),
 ) -> None:
     """Fit gyro bias against temperature for PX4 and ArduPilot (export with --format px4 or ardupilot)."""
-    from ..files import save
     from ..flight import ThermalBias, fit_thermal_bias
     from ..units import unit_factor
 
@@ -78,10 +80,12 @@ def thermal_bias(
     fs = (len(rec) - 1) / float(rec.t[-1] - rec.t[0]) if rec.has_time else rec.sample_rate
     source["units"] = rec.source_units
     tb = fit_thermal_bias(rec.gyro, rec.temp, fs, max_order=max_order, min_span=min_span, source=source)
+    doc, verdict = finish(tb.to_document(), flags, inputs=(log,), device_id=source.get("device_id"))
+    record = write_and_store(doc, flags, output, verdict, inputs=(log,), kind="thermal-bias", job="thermal-bias")
     shown = rec.source_units if rec.source_units in ("rad/s", "deg/s") else (output_units or "deg/s")
     console.print(_summary(tb, shown, 1.0 / unit_factor(shown)))
     console.print(f"{tb.duration:.0f} s at {fs:.4g} Hz; white noise {math.degrees(float(tb.noise_std.mean())):.3g} "
                   "deg/s per sample; orders chosen by leave-one-temperature-segment-out error", highlight=False)
     if output is not None:
-        save(tb, output)
         console.print(f"wrote {output}")
+    conclude(console, doc, flags, record, verdict)

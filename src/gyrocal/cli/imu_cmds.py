@@ -11,12 +11,14 @@ from ..choices import AccelModel, AccelOutputUnit, ImuGyroModel
 from ._imu_report import print_imu_run
 from ._outputs import check_output, same_document
 from ._reading import READING, read_from_flags, required_units
+from ._station import StationFlags, conclude, finish, station_flags, write_and_store
 from .app import app, console, warn
 
 __all__ = ["imu"]
 
 
 @app.command()
+@station_flags
 def imu(
     recording: Annotated[Path, typer.Argument(help="Hand session log with gyro and accelerometer columns.")],
     units: READING.Units = None,
@@ -59,6 +61,7 @@ def imu(
         "(default: none).")] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace an output that holds another calibration.")]
     = False,
+    flags: StationFlags = StationFlags(),
 ) -> None:
     """Calibrate gyro and accelerometer together from still poses and hand turns (no turntable needed)."""
     from ..errors import InputError
@@ -91,18 +94,16 @@ def imu(
     run = calibrate_recording(rec, windows=win, gravity=gravity, accel_model=accel_model, gyro_model=gyro_model,
                               g_sensitivity=g_sensitivity, min_static=min_static, output_units=output_units,
                               accel_output_units=accel_output_units)
-    doc = run.calibration.to_document()
-    check_output(output, inputs=(recording, windows, accel_log), force=force, replaceable=same_document(doc),
+    inputs = (recording, windows, accel_log)
+    doc, verdict = finish(run.calibration.to_document(), flags, inputs=inputs)
+    check_output(output, inputs=inputs, force=force, replaceable=same_document(doc),
                  holds="a different calibration or another file")
     if plot is not None:
         from ..plotting import save_figure
         from ..plotting.imu import poses_figure
 
         save_figure(poses_figure(run.result, title=f"{recording.name}: whole-IMU calibration"), plot)
-    if output is not None:
-        from ..files import save
-
-        save(run.calibration, output)
+    record = write_and_store(doc, flags, output, verdict, inputs=inputs, kind="imu", job="imu")
     for line in run.time_base.describe():
         console.print(line, highlight=False, soft_wrap=True, markup=False)
     print_imu_run(run)
@@ -110,3 +111,4 @@ def imu(
         warn(line)
     if output is not None:
         console.print(f"wrote {output}" + (f" and {plot}" if plot is not None else ""), highlight=False)
+    conclude(console, doc, flags, record, verdict)

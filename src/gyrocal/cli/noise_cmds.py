@@ -12,6 +12,7 @@ from ..choices import MotionPolicy
 from ..errors import InputError
 from ._outputs import check_output, json_format
 from ._reading import READING, read_from_flags, required_units
+from ._station import StationFlags, conclude, finish, station_flags, write_and_store
 from .app import app, console
 
 __all__ = ["noise"]
@@ -54,6 +55,7 @@ def _table(title: str, sensor, fs: float, unit: str, factor: float):
 
 
 @app.command()
+@station_flags
 def noise(
     recording: Annotated[Path, typer.Argument(
         help="Log at rest: CSV, Parquet, ROS/MCAP bag, PX4 .ulg, ArduPilot .bin.")],
@@ -77,10 +79,10 @@ def noise(
         "--json", help="Write the noise file, gyrocal.noise (default: none).")] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace a --json file that is not a noise file.")]
     = False,
+    flags: StationFlags = StationFlags(),
 ) -> None:
     """Allan deviation of a log at rest: noise density, bias instability and random walk, with intervals."""
     from ..noise import FORMAT, characterise_recording
-    from ..noise_file import save_noise
     from ..units import parse_rate_unit, unit_factor
 
     # every output is checked before anything is read, computed or written
@@ -103,6 +105,8 @@ def noise(
         raise InputError("noise figures are physical quantities, so raw accelerometer counts need their sensitivity",
                          param="accel_sensitivity", hint="give {param} (LSB per g, e.g. 16384 for +-2 g)")
     report = characterise_recording(rec, motion=motion, source={"file": recording.name})
+    doc, verdict = finish(report.to_document(), flags, inputs=(recording,))
+    record = write_and_store(doc, flags, json_out, verdict, inputs=(recording,), kind="noise", job="noise")
     shown = parse_rate_unit(output_units or "deg/s") if unit == "counts" else unit
     fs = report.sample_rate
     head = f"{report.duration:.0f} s at {fs:g} Hz, {100 * report.confidence:.0f} % intervals"
@@ -110,7 +114,6 @@ def noise(
     if report.accel is not None:
         console.print(_table(f"{recording.name}: accelerometer", report.accel, fs, "m/s^2", 1.0))
     if json_out is not None:
-        save_noise(json_out, report)
         console.print(f"wrote {json_out}")
     if plot is not None:
         from ..plotting import save_figure
@@ -118,3 +121,4 @@ def noise(
 
         save_figure(allan_figure(report, title=recording.name), plot)
         console.print(f"wrote {plot}")
+    conclude(console, doc, flags, record, verdict)

@@ -15,6 +15,7 @@ from ..choices import OutOfRange
 from ..errors import InputError
 from ._outputs import check_output, refuse_swapped, same_document
 from ._reading import READING
+from ._station import StationFlags, conclude, finish, station_flags, write_and_store
 from .app import app, console, warnings_as_lines
 
 __all__ = ["thermal", "thermal_report"]
@@ -63,6 +64,7 @@ def _read(path: Path, units: str, columns, sample_rate, sensitivity, output_unit
 
 
 @app.command("thermal")
+@station_flags
 def thermal(
     session: Annotated[Path, typer.Argument(help="Session: one CSV/Parquet/bag with every temperature point, or a folder.")],
     units: Units,
@@ -81,9 +83,9 @@ def thermal(
         "--temp-tau", help="Time constant for smoothing per-sample temperature when compensating (s).")] = 20.0,
     force: Annotated[bool, typer.Option("--force", help="Replace an -o file that holds a different calibration.")]
     = False,
+    flags: StationFlags = StationFlags(),
 ) -> None:
     """Fit a temperature table (the full-temperature-range method) from a turntable session."""
-    from ..files import save
     from ..thermal import calibrate_thermal
 
     in_u, out_u = _units(units, output_units, sensitivity)
@@ -94,11 +96,14 @@ def thermal(
                                      full_scale=_full_scale(full_scale, units, out_u, sensitivity),
                                      temp_tolerance=temp_tolerance, reference_temp=ref_temp, max_order=max_order,
                                      temp_tau=temp_tau, names=names)
-    check_output(output, inputs=(session,), force=force, replaceable=same_document(cal.to_document()),
+    inputs = [session / name for name in names] if session.is_dir() else [session]  # a folder: each file read
+    doc, verdict = finish(cal.to_document(), flags, inputs=inputs)
+    check_output(output, inputs=(session,), force=force, replaceable=same_document(doc),
                  holds="a different calibration or another file")
-    save(cal, output)
+    record = write_and_store(doc, flags, output, verdict, inputs=inputs, kind="thermal", job="thermal")
     _print_table(cal, fit)
     console.print(f"wrote {output}")
+    conclude(console, doc, flags, record, verdict)
 
 
 def _print_table(cal, fit) -> None:

@@ -120,16 +120,33 @@ def _thermal_values(doc: dict) -> dict[str, list[tuple[str, float, float]]]:
     return {"thermal_residual": [("thermal_residual", float(max(rms)), 0.0)]} if rms else {}
 
 
+def _thermal_bias_values(doc: dict) -> dict[str, list[tuple[str, float, float]]]:
+    """A bias-versus-temperature fit: its bias at the reference temperature, and its residual.
+
+    ``b`` is the calibration's bias (the reading at rest is its negative, as in [limits.b]), so it is
+    minus the fitted bias at ``tref`` (the middle of the logged range), with the 1-sigma of that
+    constant term; ``thermal_residual`` is the largest axis's RMS residual of the fit (no 1-sigma, as
+    for a temperature table). Scale factors and noise are not in such a file.
+    """
+    axes = [ax for a in _AXES if isinstance(ax := (doc.get("axes") or {}).get(a), dict)]
+    if len(axes) != 3:
+        return {}
+    b = [(f"b{a}", -float(ax["coefs"][0]), math.sqrt(float(ax["covariance"][0][0]))) for a, ax in zip(_AXES, axes)]
+    return {"b": b, "sigma_b": [(f"sigma_{n}", s, 0.0) for n, _, s in b],
+            "thermal_residual": [("thermal_residual", max(float(ax["residual_rms"]) for ax in axes), 0.0)]}
+
+
 _READERS = {"gyrocal.calibration": _calibration_values, "gyrocal.noise": _noise_values,
-            "gyrocal.thermal": _thermal_values}
+            "gyrocal.thermal": _thermal_values, "gyrocal.thermal-bias": _thermal_bias_values}
 
 
 def measured(doc: dict) -> dict[str, list[tuple[str, float, float]]]:
     """What a result document holds that limits can judge: ``parameter -> [(name, value, sigma)]``."""
     reader = _READERS.get(doc.get("format"))
     if reader is None:
-        raise InputError(f"a {doc.get('format')!r} file holds nothing limits judge; accept a calibration, noise or "
-                         "temperature file (gyrocal.calibration, gyrocal.noise, gyrocal.thermal)")
+        raise InputError(f"a {doc.get('format')!r} file holds nothing limits judge; accept a calibration, noise, "
+                         "temperature or thermal-bias file (gyrocal.calibration, gyrocal.noise, gyrocal.thermal, "
+                         "gyrocal.thermal-bias)")
     return reader(doc)
 
 

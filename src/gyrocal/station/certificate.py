@@ -22,7 +22,8 @@ _REQUIREMENT = {"k": "scale factor", "b": "bias", "misalignment": "misalignment"
                 "p_value": "fit consistency (p-value)", "sigma_k": "scale-factor uncertainty",
                 "sigma_b": "bias uncertainty"}
 _TEST = {"gyrocal.calibration": "rate calibration (turns and static windows)",
-         "gyrocal.noise": "Allan variance of a static record", "gyrocal.thermal": "temperature table"}
+         "gyrocal.noise": "Allan variance of a static record", "gyrocal.thermal": "temperature table",
+         "gyrocal.thermal-bias": "bias against temperature of a still, warming record"}
 
 
 def _num(x, digits: int = 6) -> str:
