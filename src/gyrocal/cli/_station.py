@@ -156,23 +156,18 @@ def finish(doc: dict, flags: StationFlags, *, inputs, device_id: int | None = No
     return doc, verdict
 
 
-@functools.cache
-def opened_store(url: str):
-    """The store at `url`, opened once per process (a batch worker calibrates many units) and closed at exit."""
-    import atexit
-
+def _open(url: str):
     from ..store import open_store
 
-    store = open_store(url)
-    atexit.register(store.close)
-    return store
+    return open_store(url)
 
 
 def _with_as_found(doc: dict, flags: StationFlags) -> dict:
     """`doc` with ``as_found``/``as_left`` when the store holds a calibration of the unit in force now."""
     from ..station.asfound import as_found_and_left
 
-    previous = opened_store(flags.store).in_force(flags.unit)
+    with _open(flags.store) as store:
+        previous = store.in_force(flags.unit)
     if previous is None:
         return doc
     parts = as_found_and_left(doc, previous.document, record=previous.id,
@@ -193,9 +188,10 @@ def store_result(doc: dict, flags: StationFlags, verdict: str | None, *, kind: s
 
     created = datetime.fromisoformat(unit["created"].replace("Z", "+00:00")) if unit.get("created") else None
     job, args = BATCH_JOB.get() or (job, args)
-    return opened_store(flags.store).add(unit.get("serial") or flags.unit, kind, doc, created=created,
-                                         station=flags.station, operator=flags.operator, verdict=verdict,
-                                         input_sha256=hashes[0] if len(hashes) == 1 else hashes, job=job, args=args)
+    with _open(flags.store) as store:
+        return store.add(unit.get("serial") or flags.unit, kind, doc, created=created, station=flags.station,
+                         operator=flags.operator, verdict=verdict,
+                         input_sha256=hashes[0] if len(hashes) == 1 else hashes, job=job, args=args)
 
 
 def write_and_store(doc: dict, flags: StationFlags, output: Path | None, verdict: str | None, *, inputs, kind: str,
