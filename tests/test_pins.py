@@ -192,3 +192,16 @@ def test_measured_mean_variances_give_the_gls_covariance():
                           *[k**2 * mean_var[i] for i in (6, 7)]])
     gls = np.linalg.inv(J.T @ (J / var[:, None]))
     np.testing.assert_allclose(fit.covariance, gls, rtol=1e-6, atol=1e-9 * np.diag(gls).min())
+
+
+@pytest.mark.parametrize("p, flagged", [(0.5e-3, True), (2e-3, False)])
+def test_a_fit_is_flagged_below_p_one_in_a_thousand(p, flagged):
+    """Reference: chi2.isf from scipy: twenty one-row windows whose chi2 for 14 dof (6 parameters) has p-value `p`;
+    the paper's methods (no groups) are flagged, and their covariance scaled, below p = 1e-3."""
+    from gyrocal.quality import assess_fit
+
+    total = chi2.isf(p, 20 - 6)
+    residuals = [np.array([math.sqrt(total / 20)])] * 20
+    quality = assess_fit(residuals, [f"w{i}" for i in range(20)], 6, what="the turns")
+    assert quality.p_value == pytest.approx(p, rel=1e-9)
+    assert quality.covariance_scaled is flagged and bool(quality.warnings) is flagged
