@@ -266,7 +266,7 @@ CASES = [
     ("export {bias.json} --format kalibr -o x.yaml", 2, "kalibr export takes gyrocal.noise"),
     ("export {thermal.json} --format imucal -o x.json", 2, "imucal export takes gyrocal.calibration"),
     ("export {v1_thermal} --format json -o x.json", 0, ""),
-    ("export {rec.csv} --format json -o x.json", 2, "not valid JSON"),
+    ("export {rec.csv} --format json -o x.json", 2, "a recording \\(CSV\\), not a gyrocal JSON file"),
     ("export {cal.json} --format json -o {cal.json}", 2, "also an input"),
     ("export {cal.json} --format c-header -o {rec.csv}", 2, "pass --force"),
     # imu

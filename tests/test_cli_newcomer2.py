@@ -65,3 +65,19 @@ def test_nan_rows_refused_naming_the_flag_then_dropped(folder):
     assert any("5 row(s)" in n for n in doc["fit"]["notes"])
     sd = np.asarray([doc["std"][f"k{a}"] for a in "xyz"], dtype=float)
     assert np.all(np.abs(_kvec(doc) - _kvec(ref)) < sd)
+
+
+def test_a_recording_given_for_a_json_file_is_named(folder):
+    """A CSV recording where a gyrocal file is expected: every command says what the file is, in one line."""
+    from cli_runner import refused
+
+    cal, _ = _k(folder, "s.csv")
+    rec = folder / "s.csv"
+    cases = [(("export", rec, "--format", "json", "-o", folder / "x.json"), "a recording (CSV), not a gyrocal"),
+             (("compare", rec, folder / "s.csv.json"), "a recording (CSV), not a gyrocal"),
+             (("accept", rec, "--limits", rec), "is not TOML"),
+             (("apply", folder / "s.csv.json", folder / "s.csv.json", "-o", folder / "y.csv"), "not a recording")]
+    for args, says in cases:
+        assert says in refused(*args)
+    assert "look swapped" in refused("verify", rec, folder / "s.csv.json", "--reference", rec)
+    assert "look swapped" in refused("apply", rec, folder / "s.csv.json", "-o", folder / "z.csv")

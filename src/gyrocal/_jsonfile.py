@@ -18,6 +18,25 @@ def write_json(path: str | os.PathLike, doc: dict) -> None:
     write_text_atomic(path, json.dumps(doc, indent=2, allow_nan=False) + "\n")
 
 
+def _looks_like(p: Path) -> str | None:
+    """What a file that is not JSON looks like, from its first bytes: a recording, a log, or None."""
+    with open(p, "rb") as f:
+        head = f.read(4096)
+    if head.startswith(b"ULog"):
+        return "a PX4 ULog recording"
+    if head[:3] == b"\xa3\x95\x80":
+        return "an ArduPilot DataFlash log"
+    if head.startswith(b"PAR1"):
+        return "a Parquet recording"
+    if head.startswith((b"#ROSBAG", b"\x89MCAP")):
+        return "a ROS bag"
+    text = head.decode("utf-8", "replace")
+    lines = [line for line in text.splitlines() if line.strip() and not line.startswith("#")]
+    if len(lines) >= 2 and all("," in line or "\t" in line for line in lines[:2]):
+        return "a recording (CSV)"
+    return None
+
+
 def read_json(path: str | os.PathLike) -> dict:
     """Read a JSON object, turning every failure into a :class:`FileFormatError`."""
     p = Path(path)
@@ -28,6 +47,11 @@ def read_json(path: str | os.PathLike) -> dict:
     try:
         doc = json.loads(p.read_text(encoding="utf-8"))
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        what = _looks_like(p)
+        if what is not None:
+            raise FileFormatError(f"{p}: {what}, not a gyrocal JSON file: give the file a gyrocal command wrote "
+                                  "here (gyrocal calibrate/imu/thermal/noise ... -o FILE.json), and the "
+                                  "recording where a recording is asked for") from None
         raise FileFormatError(f"{p}: not valid JSON ({exc})") from None
     if not isinstance(doc, dict):
         raise FileFormatError(f"{p}: expected a JSON object at the top level")

@@ -18,7 +18,7 @@ import typer
 from ..choices import OutOfRange, TableModel
 from ..errors import InputError
 from ._options import given
-from ._outputs import check_output
+from ._outputs import check_output, refuse_swapped
 from ._reading import READING, ReadingFlags, prefixed_params, read_from_flags, required_units
 from .app import app, console, warn
 
@@ -197,6 +197,8 @@ def verify(
         console.print(f"example: {test.name} with the reference {reference.name}\n  same as: gyrocal verify "
                       f"{calibration} {test} --reference {reference} --ref-units deg/s -o {output}", highlight=False,
                       soft_wrap=True)
+    if test is not None:
+        refuse_swapped(calibration, test, command="verify", usage="calibration file comes")
     if test is None or reference is None:
         raise InputError("give the test log and --reference REF (or --example for the bundled pair)")
     check_output(output, folder=True, inputs=(calibration, test, reference))
