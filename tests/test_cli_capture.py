@@ -291,3 +291,29 @@ def test_capture_without_pyserial_names_the_extra(tmp_path, monkeypatch):
     line = refused("capture", "--port", "/dev/ttyACM0", "-o", tmp_path / "rec.csv", "--guide", "servo")
     assert "needs pyserial" in line and "gyrocal[serial]" in line
     assert not any(tmp_path.iterdir())
+
+
+def test_station_capture_accepts_stores_and_asks_for_the_next_unit(tmp_path, servo):
+    """A guided servo capture with --unit, --limits and --store: the calibration is judged and stored, the verdict is
+    the last line a test engineer reads; with --next the serial prompt ends on an empty line. Reference: the
+    virtual device's true k (1.02, 0.98, 1.01), inside limits of +-3 % and outside +-1.5 % for kx."""
+    from gyrocal.store import open_store
+
+    limits = tmp_path / "limits.toml"
+    limits.write_text("guard = 2\n[limits.k]\nmin = 0.97\nmax = 1.03\n")
+    store = tmp_path / "station.db"
+    with VirtualDevice(device_bytes(servo, "frames", encoder="c")) as dev:
+        run = start(dev, "-o", tmp_path / "{serial}.csv", "--guide", "servo", "--unit", "SN-7", "--limits", limits,
+                    "--store", store, "--next")
+        run.wait_for("next unit: scan or type its serial")
+        run.proc.stdin.write("\n")
+        code, stdout, err = run.finish()
+    assert code == 0, err
+    assert "SN-7: PASS" in stdout and "stored as record 1" in stdout
+    doc = json.loads((tmp_path / "SN-7.cal.json").read_text())
+    assert doc["unit"]["serial"] == "SN-7" and doc["acceptance"]["verdict"] == "pass"
+    with open_store(store) as st:
+        (record,) = st.history("SN-7")
+    assert record.verdict == "pass" and record.document == doc
+    assert "{serial}" in refused("capture", "--port", "x", "-o", tmp_path / "a.csv", "--guide", "servo", "--unit", "A",
+                                 "--next")

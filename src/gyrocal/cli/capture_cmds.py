@@ -17,6 +17,7 @@ import typer
 from ..choices import AccelUnit, CaptureWire, GuideName, InputUnit
 from ..errors import GyrocalError, InputError
 from ._outputs import check_output
+from ._station import StationFlags, station_flags
 from .app import app, console, warn
 
 
@@ -174,6 +175,7 @@ def _on_event(progress: _Progress, unit: str):
 
 
 @app.command()
+@station_flags
 def capture(
     port: Annotated[str, typer.Option("--port", help="Serial port: /dev/ttyACM0, COM3, a pseudo-terminal, "
                                       "socket://HOST:PORT (anything pyserial opens).")],
@@ -211,15 +213,52 @@ def capture(
                                                         "guide completes (default: beside -o, .cal.json).")] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace existing output files.")] = False,
     quiet: Annotated[bool, typer.Option("--quiet", help="No progress line.")] = False,
+    next_unit: Annotated[bool, typer.Option("--next", help="After each unit, ask for the next serial (typed, or "
+        "from a barcode scanner) and capture again, until an empty line or Ctrl-C; -o and --cal take {serial}.",
+        rich_help_panel="Production station")] = False,
+    flags: StationFlags = StationFlags(),
 ) -> None:
     """Record a live stream from a serial port; with --guide, walk through a calibration and calibrate."""
-    from ..capture.recorder import Capture
-    from ..io import check_csv_name
-
     if columns:
         from ..io.columns import parse_columns
 
         columns = parse_columns(columns)
+    if next_unit and (guide is None or flags.unit is None or "{serial}" not in str(output)):
+        raise InputError("--next captures unit after unit: give --guide, the first --unit SERIAL, and an -o whose "
+                         "name holds {serial} (for example -o 'runs/{serial}.csv')")
+    session = dict(port=port, baud=baud, wire=wire, columns=columns, duration=duration, samples=samples,
+                   silence=silence, guide=guide, speed=speed, poses=poses, hold=hold, force=force, quiet=quiet,
+                   reading=_ReadAs(units, sensitivity, sample_rate, accel_units, accel_sensitivity))
+    failed = False
+    while True:
+        serial = flags.unit or ""
+        named = Path(str(output).replace("{serial}", serial))
+        cal = None if calibration is None else Path(str(calibration).replace("{serial}", serial))
+        failed |= _one_unit(named, cal, flags, **session) == "fail"
+        if not next_unit or (serial := _next_serial()) is None:
+            break
+        flags = replace(flags, unit=serial)
+        flags.check()
+    if failed:
+        raise typer.Exit(1)
+
+
+def _next_serial() -> str | None:
+    """The next unit's serial from stdin (a barcode scanner types it and Enter); None to stop."""
+    console.print("next unit: scan or type its serial (empty line or Ctrl-C ends)", highlight=False)
+    try:
+        line = sys.stdin.readline()
+    except KeyboardInterrupt:
+        return None
+    return line.strip() or None
+
+
+def _one_unit(output: Path, calibration: Path | None, flags: StationFlags, *, port, baud, wire, columns, duration,
+              samples, silence, guide, speed, poses, hold, force, quiet, reading) -> str | None:
+    """Capture (and with a guide, calibrate, accept and store) one unit; its verdict."""
+    from ..capture.recorder import Capture
+    from ..io import check_csv_name
+
     check_output(output, force=force, holds="another file (a recording?)")
     check_csv_name(output)
     cal_path = calibration or (output.with_suffix(".cal.json") if guide else None)
@@ -227,16 +266,15 @@ def capture(
         check_output(cal_path, flag="--cal", inputs=(output,), outputs=(output,), force=force, holds="another file")
     progress = _Progress(quiet)
     speed_rad = None if speed is None else math.radians(speed)
-    reading = _ReadAs(units, sensitivity, sample_rate, accel_units, accel_sensitivity)
     with _Stop() as stop:
         guided = None if guide is None else _Guided(guide, speed_rad, reading, progress, stop, poses=poses, hold=hold)
         cap = Capture(port, output, baud=baud, wire=wire, columns=columns, duration=duration, samples=samples,
-                      silence=silence, on_event=_on_event(progress, units))
+                      silence=silence, on_event=_on_event(progress, reading.units))
         result = cap.run(stop=stop, each=guided, keep_from=None if guided is None else guided.keep_from)
         if guided is not None and not guided.guide.complete:
             guided(cap, force=True)  # the last samples, read after the last look
     progress.clear()
-    _finish(result, port, reading, guided, cal_path, speed_rad)
+    return _finish(result, port, reading, guided, cal_path, speed_rad, flags)
 
 
 @dataclass(frozen=True)
@@ -257,7 +295,7 @@ class _ReadAs:
                        accel_sensitivity=self.accel_sensitivity or hello.accel_sensitivity)
 
 
-def _finish(result, port, reading: _ReadAs, guided, cal_path, speed_rad) -> None:
+def _finish(result, port, reading: _ReadAs, guided, cal_path, speed_rad, flags: StationFlags) -> str | None:
     from ..capture.report import calibrate_capture, summary
 
     if result.path is None:
@@ -268,13 +306,12 @@ def _finish(result, port, reading: _ReadAs, guided, cal_path, speed_rad) -> None
     reading = reading.completed(result.hello)
     units, sens, sample_rate = reading.units, reading.sensitivity, reading.sample_rate
     calibrate_args = {"units": units, "sensitivity": sens, "sample_rate": sample_rate}
+    doc = verdict = None
     if guided is not None and guided.guide.complete and guided.guide.name == "multi-position":
-        _calibrate_imu(result.path, reading, guided.guide.windows(), cal_path)
+        doc, verdict = _calibrate_imu(result.path, reading, guided.guide.windows(), cal_path, flags)
     elif guided is not None and guided.guide.complete:
         run = calibrate_capture(result.path, windows=guided.guide.windows(), speed=speed_rad, **calibrate_args)
-        from ..files import save
-
-        save(run.calibration, cal_path)
+        doc, verdict = _station_result(run.calibration, cal_path, flags, result.path, "calibration")
         console.print(run.report(), highlight=False, soft_wrap=True, markup=False)
         console.print(f"wrote {cal_path}", highlight=False, markup=False)
     elif guided is not None:
@@ -286,22 +323,38 @@ def _finish(result, port, reading: _ReadAs, guided, cal_path, speed_rad) -> None
         console.print(f"next: gyrocal calibrate {result.path} {how} --angle 360 -o cal.json", highlight=False,
                       soft_wrap=True, markup=False)
     _device_answer(result, calibrate_args, speed_rad)
+    if doc is not None and (flags.unit is not None or verdict is not None):
+        from ._station import print_verdict
+
+        print_verdict(console, doc)
+    return verdict
 
 
-def _calibrate_imu(path, reading: _ReadAs, windows, cal_path) -> None:
+def _station_result(cal, cal_path: Path, flags: StationFlags, recording: Path, kind: str) -> tuple[dict, str | None]:
+    """The calibration file with the unit and its acceptance, written and stored; the document and verdict."""
+    from ._station import finish, write_and_store
+
+    doc, verdict = finish(cal.to_document(), flags, inputs=(recording,))
+    record = write_and_store(doc, flags, cal_path, verdict, inputs=(recording,), kind=kind, job="capture")
+    if record is not None:
+        console.print(f"stored as record {record} in {flags.store}", highlight=False)
+    return doc, verdict
+
+
+def _calibrate_imu(path, reading: _ReadAs, windows, cal_path, flags: StationFlags) -> tuple[dict, str | None]:
     """The whole-IMU calibration of a guided multi-position session, from the written recording."""
     from ..capture.report import calibrate_imu_capture
-    from ..files import save
     from ._imu_report import print_imu_run
 
     run = calibrate_imu_capture(path, units=reading.units, sensitivity=reading.sensitivity,
                                 sample_rate=reading.sample_rate, accel_units=reading.accel_units,
                                 accel_sensitivity=reading.accel_sensitivity, windows=windows)
-    save(run.calibration, cal_path)
+    doc, verdict = _station_result(run.calibration, cal_path, flags, path, "imu")
     print_imu_run(run, windows_from="the guide")
     for line in run.warnings:
         warn(line)
     console.print(f"wrote {cal_path}", highlight=False, markup=False)
+    return doc, verdict
 
 
 def _device_answer(result, calibrate_args: dict, speed_rad) -> None:
