@@ -201,7 +201,7 @@ CASES = [
     ("segments {cal.json} --units deg/s", 2, "not a recording"),
     ("segments {rec.csv} --units deg/s --plot {rec.csv}", 2, "also an input"),
     # apply
-    ("apply {cal.json}", 2, "missing argument 'recording'"),
+    ("apply {cal.json}", 2, "missing option '-o'"),
     ("apply {cal.json} {rec.csv}", 2, "missing option '-o'"),
     ("apply {rec.csv} {cal.json} -o out.csv", 2, "arguments look swapped; the calibration file comes first"),
     ("apply {cal.json} {rec.csv} -o out.csv", 0, ""),

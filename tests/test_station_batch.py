@@ -121,3 +121,26 @@ def test_history_export_and_list(lot, tmp_path):
     assert "no calibration in force" in refused("store", "export", "SN-H", "--store", store, "-o",
                                                 tmp_path / "x.json", "--at", "2001-01-01T00:00:00Z")
     assert "ISO 8601" in refused("store", "list", "--store", store, "--since", "yesterday")
+
+
+def test_apply_takes_the_calibration_in_force_from_the_store(lot, tmp_path):
+    """apply --store --unit: the unit's calibration in force at the recording's file time (or --at) corrects it
+    exactly as the exported file does (reference: apply with that file)."""
+    store = tmp_path / "s.db"
+    code, _, err = invoke("calibrate", lot / "a.csv", *SPEED.split(), "--unit", "SN-P", "--store", store,
+                          "-o", tmp_path / "a.json")
+    assert code == 0, err
+    recording = tmp_path / "rec.csv"
+    recording.write_bytes((lot / "b.csv").read_bytes())  # written now: after the calibration
+    code, out, err = invoke("apply", "--store", store, "--unit", "SN-P", recording, "-o", tmp_path / "from-store.csv")
+    assert code == 0, err
+    assert "record 1 of" in out and "the recording's file time" in out
+    code, _, err = invoke("apply", tmp_path / "a.json", recording, "-o", tmp_path / "from-file.csv")
+    assert code == 0, err
+    body = [line for line in (tmp_path / "from-store.csv").read_text().splitlines() if not line.startswith("#")]
+    assert body == [line for line in (tmp_path / "from-file.csv").read_text().splitlines() if not line.startswith("#")]
+    assert "no calibration in force" in refused("apply", "--store", store, "--unit", "SN-P", recording, "-o",
+                                                tmp_path / "x.csv", "--at", "2001-01-01T00:00:00Z")
+    assert "--unit SERIAL" in refused("apply", "--store", store, recording, "-o", tmp_path / "x.csv")
+    assert "give only the recording" in refused("apply", "--store", store, "--unit", "SN-P", tmp_path / "a.json",
+                                                recording, "-o", tmp_path / "x.csv")

@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Optional
 
 import typer
 
 from ..choices import OutOfRange, TableModel
 from ..errors import InputError
-from ._options import given
+from ._options import given, iso_time
 from ._outputs import check_output, refuse_swapped, starts_with
 from ._reading import READING, read_from_flags
 from .app import app, console, warn
@@ -24,9 +24,10 @@ _APPLY_OPTIONS = ("model", "out_of_range")
 @app.command()
 def apply(
     ctx: typer.Context,
-    calibration: Annotated[Path, typer.Argument(help="A gyrocal calibration or thermal calibration file.")],
-    recording: Annotated[Path, typer.Argument(help="Recording to correct.")],
+    calibration: Annotated[Path, typer.Argument(help="A gyrocal calibration or thermal calibration file (with "
+                                                "--store: the recording).")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Corrected CSV.")],
+    recording: Annotated[Optional[Path], typer.Argument(help="Recording to correct.")] = None,
     units: READING.UnitsOfCalibration = None,
     columns: READING.Columns = None,
     skip_rows: READING.SkipRows = None,
@@ -45,15 +46,33 @@ def apply(
     force: Annotated[bool, typer.Option(
         "--force", help="Replace an existing output that gyrocal did not write, and correct data that "
         "'gyrocal apply' already corrected.")] = False,
+    store: Annotated[Optional[str], typer.Option(
+        "--store", help="Take the calibration from this store: the unit's (--unit) in force at the recording's "
+        "time (its file's modification time, or --at); give only the recording.", metavar="URL",
+        rich_help_panel="Production station")] = None,
+    unit_serial: Annotated[Optional[str], typer.Option("--unit", help="With --store: the unit's serial.",
+                                                       metavar="SERIAL", rich_help_panel="Production station")] = None,
+    at: Annotated[Optional[str], typer.Option("--at", help="With --store: the time (ISO 8601) instead of the "
+                                              "recording's.", rich_help_panel="Production station")] = None,
 ) -> None:
     """Correct a recording; gyro columns are replaced by corrected rates, other columns pass through."""
-    from ..files import load_correction
+    # long function: the command's steps in order (calibration, reading, checks, correction, output)
     from ..io import check_csv_name, read_header_comment, write_recording
 
-    refuse_swapped(calibration, recording, command="apply", usage="calibration file comes")
+    if store is not None:
+        if recording is not None:
+            raise InputError("with --store give only the recording: the calibration comes from the store")
+        recording, (cal, calibration) = calibration, _from_store(store, unit_serial, calibration, at)
+    elif recording is None:
+        raise InputError("give the calibration file and the recording (or --store URL --unit SERIAL and the "
+                         "recording)")
+    else:
+        from ..files import load_correction
+
+        refuse_swapped(calibration, recording, command="apply", usage="calibration file comes")
+        cal = load_correction(calibration)
     check_output(output, inputs=(calibration, recording), force=force, replaceable=starts_with(f"# {_APPLIED}"))
     check_csv_name(output)
-    cal = load_correction(calibration)
     comment = read_header_comment(recording)
     if not force and comment is not None and comment.startswith(_APPLIED):
         raise InputError(f"{recording.name} was written by 'gyrocal apply' ('# {comment[:60]}'): its rates are "
@@ -91,6 +110,36 @@ def apply(
     note = f"{_APPLIED} with {Path(calibration).name}; gx gy gz in {out_units}{accel}"
     write_recording(output, corrected, header_comment=note)
     console.print(f"wrote {output} ({len(corrected)} rows, gx gy gz in {out_units})", highlight=False)
+
+
+def _from_store(url: str, serial: str | None, recording: Path, at: str | None):
+    """The unit's calibration in force at the recording's time, and a name for it (a path of the store)."""
+    from datetime import datetime, timezone
+
+    from ..calibration import Calibration
+    from ..files import from_document
+    from ..station.identity import check_serial
+    from ..store import open_store
+    from ..thermal.model import ThermalCalibration
+
+    if serial is None:
+        raise InputError("--store needs the unit: give --unit SERIAL")
+    serial = check_serial(serial)
+    if at is not None:
+        when, why = iso_time(at, "--at"), "--at"
+    elif recording.is_file():
+        when, why = datetime.fromtimestamp(recording.stat().st_mtime, timezone.utc), "the recording's file time"
+    else:
+        raise InputError(f"recording {recording} not found")
+    with open_store(url) as st:
+        record = st.in_force(serial, when)
+    if record is None:
+        raise InputError(f"unit {serial} has no calibration in force at {when:%Y-%m-%dT%H:%M:%SZ} ({why}) in {url}")
+    name = Path(f"{serial}-record-{record.id}.json")
+    cal = from_document(record.document, name, (Calibration, ThermalCalibration))
+    console.print(f"calibration: record {record.id} of {url} ({record.created:%Y-%m-%dT%H:%M:%SZ}), in force at "
+                  f"{when:%Y-%m-%dT%H:%M:%SZ} ({why})", highlight=False, soft_wrap=True)
+    return cal, name
 
 
 def _accel_reading(ctx, cal, accel_units: str | None, gravity: float) -> tuple[str | None, float]:
