@@ -91,7 +91,7 @@ class ThermalBias(TemperaturePolynomial):
 
     #: File kind (registered by :mod:`gyrocal.thermal_bias_file`, which holds the document code).
     FORMAT: ClassVar[str] = "gyrocal.thermal-bias"
-    VERSION: ClassVar[int] = 1
+    VERSION: ClassVar[int] = 2
 
     def to_document(self) -> dict:
         """The JSON-ready document (``format: gyrocal.thermal-bias``)."""
@@ -110,6 +110,10 @@ class ThermalBias(TemperaturePolynomial):
         check_curve(self)
         if self.accel is not None and not isinstance(self.accel, AccelDrift):
             raise InputError(f"accel must be an AccelDrift or None, got {type(self.accel).__name__}")
+        if self.accel is not None and (self.accel.tref, self.accel.tmin, self.accel.tmax) != (
+                self.tref, self.tmin, self.tmax):
+            # one INS_TCALn_TMIN/TMAX serves both sensors in ArduPilot: the fits share their range
+            raise InputError("the accelerometer part must cover the gyro's range and reference temperature")
 
     def bias_at(self, temp) -> np.ndarray:
         """Bias (N, 3) [rad/s] at temperatures (N,) [degC], clipped to ``[tmin, tmax]``."""
