@@ -168,9 +168,12 @@ def ardupilot_params(tb: ThermalBias, *, imu: int = 1, caltemp: float | None = N
     offset = tb.bias_at([tcal])[0]  # what the firmware's constant offsets must hold at Tcal (clipped like T)
     offs, caltemp_name = _ardupilot_names(n)
     rows = [(f"INS_TCAL{n}_ENABLE", "1"), (f"INS_TCAL{n}_TMIN", f32(tb.tmin)), (f"INS_TCAL{n}_TMAX", f32(tb.tmax))]
-    acc = np.zeros((3, MAX_ORDER + 1)) if tb.accel is None else tb.accel.coefficients_about(ARDUPILOT_TREF)
-    rows += [(f"INS_TCAL{n}_ACC{k}_{ax}", f32(acc[a, k] * ARDUPILOT_SCALE)) for k in range(1, 4)
-             for a, ax in enumerate("XYZ")]
+    if tb.accel is None:
+        rows += [(f"INS_TCAL{n}_ACC{k}_{ax}", "0") for k in range(1, 4) for ax in "XYZ"]
+    else:
+        acc = tb.accel.coefficients_about(ARDUPILOT_TREF)  # the constant is dropped: the firmware's P has none
+        rows += [(f"INS_TCAL{n}_ACC{k}_{ax}", f32(acc[a, k] * ARDUPILOT_SCALE)) for k in range(1, 4)
+                 for a, ax in enumerate("XYZ")]
     rows += [(f"INS_TCAL{n}_GYR{k}_{ax}", f32(c35[a, k] * ARDUPILOT_SCALE)) for k in range(1, 4)
              for a, ax in enumerate("XYZ")]
     rows += [(f"{offs}_{ax}", f32(offset[a])) for a, ax in enumerate("XYZ")] + [(caltemp_name, f32(tcal))]
