@@ -195,12 +195,20 @@ def test_cli_refusals(warm_csv, tmp_path):
 
 
 def test_cli_dataflash(tmp_path):
-    """An ArduPilot log (IMU messages at 25 Hz, accelerometer in m/s^2, no TCAL in force): the change holds
-    the generator's truth within 4 sigma; g is refused for a flight log (ArduPilot logs m/s^2)."""
+    """An ArduPilot log (IMU messages at 25 Hz) whose accelerometer was logged corrected by an older TCAL
+    set, offsets and scale (firmware_models.ardupilot_correct, sensor ACC): the reader undoes them and the
+    change holds the generator's truth within 4 sigma; g is refused for a flight log (ArduPilot logs m/s^2)."""
     t, gyro, accel, _, temp = warming_log(31, duration=1200.0)
     keep = slice(None, None, 2)
+    old = {"INS_TCAL1_ENABLE": 1.0, "INS_TCAL1_TMIN": 0.0, "INS_TCAL1_TMAX": 40.0, "INS_ACC1_CALTEMP": 20.0,
+           **{f"INS_TCAL1_{s}{k}_{ax}": 0.0 for s in ("ACC", "GYR") for k in (1, 2, 3) for ax in "XYZ"},
+           "INS_TCAL1_ACC1_X": 15000.0, "INS_TCAL1_ACC2_Z": 40.0, "INS_ACCOFFS_X": 0.1, "INS_ACCOFFS_Y": -0.2,
+           "INS_ACCOFFS_Z": 0.05, "INS_ACCSCAL_X": 1.01, "INS_ACCSCAL_Y": 0.99, "INS_ACCSCAL_Z": 1.0}
+    logged = ardupilot_correct(old, 1, temp[keep], accel[keep], sensor="ACC").astype(float)
     w = imu_log()
-    for k, (g, a, tt) in enumerate(zip(gyro[keep], accel[keep], temp[keep])):
+    for name, value in old.items():
+        w.write("PARM", 1000, name, value)
+    for k, (g, a, tt) in enumerate(zip(gyro[keep], logged, temp[keep])):
         w.write("IMU", 10_000 + 40_000 * k, 0, *g, *a, 0, 0, float(tt), 1, 1, 25, 25)
     log = tmp_path / "00000007.BIN"
     log.write_bytes(bytes(w))
