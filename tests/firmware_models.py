@@ -8,6 +8,10 @@
   AP_InertialSensor_tempcal.cpp): float32; T and the calibration temperature both clipped to
   [TMIN, TMAX]; ``v -= P(T - 35) - P(Tcal - 35)``, ``P(x) = (c1 + (c2 + c3 x) x) x 1e-6``; then the
   backend subtracts ``INS_GYROFFS`` (``_rotate_and_correct_gyro``).
+* The accelerometer goes the same ways: PX4's ``TC_A{i}`` set through the same
+  ``calc_thermal_offsets_3D``; ArduPilot's ``correct_accel`` is ``correct_sensor`` with the
+  ``ACC1..3`` coefficients and ``INS_ACCn_CALTEMP``, then ``accel -= INS_ACCOFFS`` and
+  ``accel *= INS_ACCSCAL`` (``_rotate_and_correct_accel``).
 
 Used by the exporter tests and by the DataFlash test, which writes logs corrected this way.
 """
@@ -29,9 +33,9 @@ def parse_px4(text: str) -> dict:
     return params
 
 
-def px4_offsets(params: dict, i: int, temp: np.ndarray) -> np.ndarray:
-    """calc_thermal_offsets_3D of PX4, in float32."""
-    tmin, tmax, tref = (F32(params[f"TC_G{i}_{k}"]) for k in ("TMIN", "TMAX", "TREF"))
+def px4_offsets(params: dict, i: int, temp: np.ndarray, sensor: str = "G") -> np.ndarray:
+    """calc_thermal_offsets_3D of PX4, in float32, for the TC_G (gyro) or TC_A (accelerometer) set."""
+    tmin, tmax, tref = (F32(params[f"TC_{sensor}{i}_{k}"]) for k in ("TMIN", "TMAX", "TREF"))
     out = np.empty((len(temp), 3), dtype=np.float32)
     for j, t in enumerate(temp.astype(np.float32)):
         if t > tmax:
@@ -43,7 +47,7 @@ def px4_offsets(params: dict, i: int, temp: np.ndarray) -> np.ndarray:
         d2 = F32(d * d)
         d3 = F32(d2 * d)
         for a in range(3):
-            x = [F32(params[f"TC_G{i}_X{n}_{a}"]) for n in range(4)]
+            x = [F32(params[f"TC_{sensor}{i}_X{n}_{a}"]) for n in range(4)]
             out[j, a] = x[0] + x[1] * d + x[2] * d2 + x[3] * d3
     return out
 
@@ -59,19 +63,21 @@ def parse_ardupilot(text: str) -> dict:
     return params
 
 
-def ardupilot_correct(params: dict, n: int, temp: np.ndarray, gyro: np.ndarray) -> np.ndarray:
-    """correct_sensor of AP_InertialSensor_TCal, then the constant offsets, in float32."""
+def ardupilot_correct(params: dict, n: int, temp: np.ndarray, gyro: np.ndarray, sensor: str = "GYR") -> np.ndarray:
+    """correct_sensor of AP_InertialSensor_TCal, then the constant offsets (and for ACC the scale), in float32."""
     tmin, tmax = F32(params[f"INS_TCAL{n}_TMIN"]), F32(params[f"INS_TCAL{n}_TMAX"])
-    c = np.array([[params[f"INS_TCAL{n}_GYR{k}_{ax}"] for ax in "XYZ"] for k in (1, 2, 3)], dtype=np.float32)
-    offs = "INS_GYROFFS" if n == 1 else f"INS_GYR{n}OFFS"
+    c = np.array([[params[f"INS_TCAL{n}_{sensor}{k}_{ax}"] for ax in "XYZ"] for k in (1, 2, 3)], dtype=np.float32)
+    offs = f"INS_{sensor}OFFS" if n == 1 else f"INS_{sensor}{n}OFFS"
     offset = np.array([params[f"{offs}_{ax}"] for ax in "XYZ"], dtype=np.float32)
+    scal = "INS_ACCSCAL" if n == 1 else f"INS_ACC{n}SCAL"
+    scale = np.array([params.get(f"{scal}_{ax}", 1.0) if sensor == "ACC" else 1.0 for ax in "XYZ"], np.float32)
 
     def poly(tdiff):
         return (c[0] + (c[1] + c[2] * tdiff) * tdiff) * tdiff * F32(1e-6)
 
     t = np.clip(temp.astype(np.float32), tmin, tmax)[:, None]
-    cal = np.clip(F32(params[f"INS_GYR{n}_CALTEMP"]), tmin, tmax)
+    cal = np.clip(F32(params[f"INS_{sensor}{n}_CALTEMP"]), tmin, tmax)
     v = gyro.astype(np.float32) - poly(t - F32(35.0)) + poly(cal - F32(35.0))
-    return v - offset
+    return (v - offset) * scale
 
 

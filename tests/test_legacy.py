@@ -121,3 +121,20 @@ def test_upgrade_leaves_the_old_document_alone_and_names_missing_fields():
     with pytest.raises(FileFormatError, match="neither 'seed000' nor 'seed001'"):
         upgrade(bad, "x")
     assert upgrade({"format": "gyrocal.calibration", "version": True}, "x")["version"] is True  # refused later
+
+
+def test_v1_thermal_bias_loads_and_exports_as_it_did(tmp_path):
+    """A version 1 thermal-bias file (gyro only, made before the accelerometer section) loads as version 2 with
+    no accelerometer, and exports the PX4 and ArduPilot parameters the old gyrocal wrote from it (reference:
+    tests/data/v1_thermal_bias.params and .parm, written by that gyrocal)."""
+    old = _old("v1_thermal_bias.json")
+    assert old["version"] == 1 and "accelerometer" not in old
+    tb = load(DATA / "v1_thermal_bias.json")
+    doc = tb.to_document()
+    assert doc["version"] == 2 and doc["accelerometer"] is None and doc["axes"] == old["axes"]
+    for fmt, name, extra in (("px4", "v1_thermal_bias.params", ("--device-id", "7")),
+                             ("ardupilot", "v1_thermal_bias.parm", ())):
+        out = tmp_path / name
+        assert invoke("export", DATA / "v1_thermal_bias.json", "--format", fmt, "-o", out, *extra)[0] == 0
+        rows = [line for line in out.read_text().splitlines() if not line.startswith("#")]
+        assert rows == [line for line in (DATA / name).read_text().splitlines() if not line.startswith("#")]

@@ -45,11 +45,13 @@ def _bias(obj) -> ThermalBias:
     return bias_from_thermal(obj) if isinstance(obj, ThermalCalibration) else obj
 
 
-def px4(obj, *, slot: int | None = None, device_id: int | None = None, **options) -> str:
-    """PX4 ``TC_G`` parameters; `slot` defaults to the log's IMU instance (0 otherwise)."""
+def px4(obj, *, slot: int | None = None, device_id: int | None = None, accel_device_id: int | None = None,
+        **options) -> str:
+    """PX4 ``TC_G`` (and ``TC_A``) parameters; `slot` defaults to the log's IMU instance (0 otherwise)."""
     refuse_options(options, (), "px4 export")
     tb = _bias(obj)
-    return px4_params(tb, instance=tb.source.get("instance", 0) if slot is None else slot, device_id=device_id)
+    return px4_params(tb, instance=tb.source.get("instance", 0) if slot is None else slot, device_id=device_id,
+                      accel_device_id=accel_device_id)
 
 
 def ardupilot(obj, *, slot: int | None = None, caltemp: float | None = None, **options) -> str:

@@ -18,6 +18,10 @@ reader of files accepts old ones. The steps, and what changed:
     Per-axis gyro lists (``arw``, ``bias_instability``, ``rrw``) become figures per axis and
     for the sensor (``gyroscope.x.density.value``, ...) with intervals (null: unknown); the
     accelerometer section appears (null). See :func:`gyrocal.noise_file.upgrade_v1`.
+
+``gyrocal.thermal-bias`` 1 -> 2
+    The optional ``accelerometer`` section (the offsets' change from ``tref``) appears (null);
+    the gyro's fields are unchanged.
 """
 
 from __future__ import annotations
@@ -85,11 +89,19 @@ def _noise_1_to_2(doc: dict, path) -> dict:
     return upgrade_v1(doc, path)
 
 
+def _thermal_bias_1_to_2(doc: dict, path) -> dict:
+    _need(doc, "axes", path)
+    out = dict(doc)
+    out.update(version=2, accelerometer=None)
+    return out
+
+
 #: (format, version) -> the step to version + 1.
 UPGRADES: dict[tuple[str, int], Upgrade] = {
     ("gyrocal.calibration", 1): _calibration_1_to_2,
     ("gyrocal.thermal", 1): _thermal_1_to_2,
     ("gyrocal.noise", 1): _noise_1_to_2,
+    ("gyrocal.thermal-bias", 1): _thermal_bias_1_to_2,
 }
 
 

@@ -101,6 +101,7 @@ FLAGS: dict[str, str] = {
     "use_bound": "--random-walk-bound",
     "slot": "--slot",
     "device_id": "--device-id",
+    "accel_device_id": "--accel-device-id",
     "caltemp": "--caltemp",
     "name": "--name",
     # capture, simulate --device

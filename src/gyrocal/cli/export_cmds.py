@@ -50,6 +50,9 @@ def export(
         "--slot", help="px4: TC_G slot 0-3; ardupilot: INS_TCAL set 1-3 (default: the log's IMU).")] = None,
     device_id: Annotated[Optional[int], typer.Option(
         "--device-id", help="px4: the gyro's device id, TC_Gn_ID (default: the one in the ULog).")] = None,
+    accel_device_id: Annotated[Optional[int], typer.Option(
+        "--accel-device-id", help="px4: the accelerometer's device id, TC_An_ID, for a thermal-bias file with an "
+                                  "accelerometer part (default: the one in the ULog).")] = None,
     caltemp: Annotated[Optional[float], typer.Option(
         "--caltemp", help="ardupilot: temperature of the INS_GYROFFS companion [degC] (default: mid-range).")]
     = None,
@@ -63,7 +66,7 @@ def export(
     typed = {"prefix": prefix, "rostopic": rostopic, "update_rate": update_rate, "inflate": inflate,
              "accel_noise_density": accel_noise_density, "accel_random_walk": accel_random_walk,
              "gyro_random_walk": gyro_random_walk, "use_bound": random_walk_bound or None, "name": name,
-             "slot": slot, "device_id": device_id, "caltemp": caltemp}
+             "slot": slot, "device_id": device_id, "accel_device_id": accel_device_id, "caltemp": caltemp}
     options = {k: v for k, v in typed.items() if v is not None}  # an exporter refuses options it does not take
     text = render(calibration, format, **options)
     check_output(output, inputs=(calibration,), force=force, replaceable=same_text(text))

@@ -1,4 +1,5 @@
-"""Command ``thermal-bias``: gyro bias against temperature from a still log of a warming board."""
+"""Command ``thermal-bias``: gyro bias (and the accelerometer's offset change) against temperature from a still
+log of a warming board."""
 
 from __future__ import annotations
 
@@ -16,29 +17,38 @@ from .app import app, console
 __all__ = ["thermal_bias"]
 
 
-def _read(log: Path, units, columns, sample_rate, sensitivity, output_units, imu):
-    """The recording and what the log says about its IMU (PX4 device id, ArduPilot IMU number)."""
+def _read(log: Path, units, columns, sample_rate, sensitivity, output_units, imu, accel: dict):
+    """The recording and what the log says about its IMU (PX4 device ids, ArduPilot IMU number)."""
+    from ..errors import InputError
     from ..io.flightlog import flight_log_kind, read_flight_log
 
     if log.is_file() and flight_log_kind(log) is not None:
-        rec, info = read_flight_log(log, imu=imu, units=units)
-        return rec, {"file": log.name, **info}
-    rec = read_from_flags(log, units=required_units(units), columns=columns, sample_rate=sample_rate,
-                          sensitivity=sensitivity, output_units=output_units, imu=imu)
-    return rec, {"file": log.name}
+        rec, info = read_flight_log(log, imu=imu, units=units, accel_units=accel["accel_units"])
+        source = {"file": log.name, **info}
+    else:
+        rec = read_from_flags(log, units=required_units(units), columns=columns, sample_rate=sample_rate,
+                              sensitivity=sensitivity, output_units=output_units, imu=imu, **accel)
+        source = {"file": log.name}
+    if accel["accel_units"] is not None and rec.accel is None:
+        raise InputError(f"{log.name} has no accelerometer columns (ax, ay, az)", param="accel_units",
+                         hint="map them with --columns ax=..,ay=..,az=.., or leave out {param}")
+    if rec.accel_units == "counts":
+        raise InputError("the accelerometer's change with temperature is fitted in m/s^2, so raw counts need their "
+                         "sensitivity", param="accel_sensitivity", hint="give {param} (LSB per g)")
+    return rec, source
 
 
-def _summary(tb, unit: str, factor: float):
+def _summary(tb, unit: str, factor: float, title: str | None = None):
     import numpy as np
     from rich.table import Table
 
-    table = Table(title=f"bias = sum X_n (T - {tb.tref:.2f})^n, T clipped to {tb.tmin:.2f}..{tb.tmax:.2f} degC",
-                  caption="bias above its 1-sigma")
+    table = Table(title=title or f"bias = sum X_n (T - {tb.tref:.2f})^n, T clipped to {tb.tmin:.2f}..{tb.tmax:.2f} "
+                  "degC", caption="value above its 1-sigma")
     for col in ("axis", "order", f"at {tb.tmin:.1f} C\n{unit}", f"at {tb.tref:.1f} C\n{unit}",
                 f"at {tb.tmax:.1f} C\n{unit}", f"1-sigma max\n{unit}", f"residual\n{unit}"):
         table.add_column(col, justify="right", no_wrap=True)
     temps = [tb.tmin, tb.tref, tb.tmax]
-    bias, sd = tb.bias_at(temps) * factor, tb.std_at(temps) * factor
+    bias, sd = tb.value_at(temps) * factor, tb.std_at(temps) * factor
     worst = tb.std_at(np.linspace(tb.tmin, tb.tmax, 25)).max(axis=0) * factor
     for a, axis in enumerate("xyz"):
         table.add_row(axis, str(int(tb.orders[a])), *(f"{bias[i, a]:.4g}\n\u00b1{sd[i, a]:.2g}" for i in range(3)),
@@ -62,16 +72,23 @@ def thermal_bias(
     = 3,
     min_span: Annotated[float, typer.Option(
         "--min-span", help="Smallest temperature span accepted [degC] (ArduPilot's minimum: 10).")] = 10.0,
+    accel_units: Annotated[Optional[str], typer.Option(
+        "--accel-units", help="Also fit the accelerometer's offset change from the reference temperature: unit of "
+        "its columns, m/s^2 or g (counts with --accel-sensitivity; flight logs: m/s^2).",
+        metavar="<m/s^2|g|counts>")] = None,
+    accel_sensitivity: READING.AccelSensitivity = None,
+    gravity: READING.Gravity = 9.80665,
     force: Annotated[bool, typer.Option("--force", help="Replace an -o file that is not a thermal-bias file.")]
     = False,
     flags: StationFlags = StationFlags(),
 ) -> None:
-    """Fit gyro bias against temperature for PX4 and ArduPilot (export with --format px4 or ardupilot)."""
+    """Fit gyro bias (and accelerometer offset change) against temperature for PX4 and ArduPilot (export with
+    --format px4 or ardupilot)."""
     from ..flight import ThermalBias, fit_thermal_bias
-    from ..units import unit_factor
 
     check_output(output, inputs=(log,), force=force, replaceable=json_format(ThermalBias.FORMAT))
-    rec, source = _read(log, units, columns, sample_rate, sensitivity, output_units, imu)
+    accel = {"accel_units": accel_units, "accel_sensitivity": accel_sensitivity, "gravity": gravity}
+    rec, source = _read(log, units, columns, sample_rate, sensitivity, output_units, imu, accel)
     if rec.temp is None:
         from ..errors import InputError
 
@@ -79,13 +96,28 @@ def thermal_bias(
                          hint="map it with {param} temp=NAME")
     fs = (len(rec) - 1) / float(rec.t[-1] - rec.t[0]) if rec.has_time else rec.sample_rate
     source["units"] = rec.source_units
-    tb = fit_thermal_bias(rec.gyro, rec.temp, fs, max_order=max_order, min_span=min_span, source=source)
+    if rec.accel is not None:
+        source["accel_units"] = rec.accel_source_units
+    tb = fit_thermal_bias(rec.gyro, rec.temp, fs, max_order=max_order, min_span=min_span, source=source,
+                          accel=rec.accel)
     doc, verdict = finish(tb.to_document(), flags, inputs=(log,), device_id=source.get("device_id"))
     record = write_and_store(doc, flags, output, verdict, inputs=(log,), kind="thermal-bias", job="thermal-bias")
+    _print(tb, rec, output_units, gravity, fs)
+    if output is not None:
+        console.print(f"wrote {output}")
+    conclude(console, doc, flags, record, verdict)
+
+
+def _print(tb, rec, output_units, gravity: float, fs: float) -> None:
+    from ..units import unit_factor
+
     shown = rec.source_units if rec.source_units in ("rad/s", "deg/s") else (output_units or "deg/s")
     console.print(_summary(tb, shown, 1.0 / unit_factor(shown)))
     console.print(f"{tb.duration:.0f} s at {fs:.4g} Hz; white noise {math.degrees(float(tb.noise_std.mean())):.3g} "
                   "deg/s per sample; orders chosen by leave-one-temperature-segment-out error", highlight=False)
-    if output is not None:
-        console.print(f"wrote {output}")
-    conclude(console, doc, flags, record, verdict)
+    if tb.accel is None:
+        return
+    unit = "g" if rec.accel_source_units == "g" else "m/s^2"
+    title = (f"accelerometer: change of the offsets from {tb.tref:.2f} degC (zero there: one orientation gives the "
+             f"change, not the offset) = sum X_n (T - {tb.tref:.2f})^n")
+    console.print(_summary(tb.accel, unit, 1.0 / gravity if unit == "g" else 1.0, title))

@@ -15,11 +15,12 @@ The thermal-bias file is :mod:`gyrocal.thermal_bias_file`; the exporters are reg
 from .firmware_params import ardupilot_params, px4_params
 from .from_table import ScaleNotCarriedWarning, bias_from_thermal
 from .temperature import TemperatureCourse, temperature_course
-from .thermal_bias import MAX_ORDER, ThermalBias, ThermalBiasWarning, fit_thermal_bias
+from .thermal_bias import MAX_ORDER, AccelDrift, ThermalBias, ThermalBiasWarning, fit_thermal_bias
 from .vio import imu_utils_yaml, kalibr_yaml, vins_yaml, vio_values
 
 __all__ = [
     "MAX_ORDER",
+    "AccelDrift",
     "ScaleNotCarriedWarning",
     "TemperatureCourse",
     "ThermalBias",

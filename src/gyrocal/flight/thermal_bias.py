@@ -15,11 +15,14 @@ fits the same kind of polynomial, but
 
 The model, per axis: ``bias(T) = sum_n coefs[n] (T - tref)^n`` [rad/s], ``T`` clipped to
 ``[tmin, tmax]``, and the compensated rate is ``reading - bias(T)``: PX4's form exactly.
+
+With the accelerometer's readings the same blocks, order choice and 1-sigma give its offsets'
+*change* from ``tref`` (:class:`.curve.AccelDrift`, zero at ``tref``): a board in one
+orientation cannot tell an offset from gravity, only how the reading moves with temperature.
 """
 
 from __future__ import annotations
 
-import math
 import warnings
 from dataclasses import dataclass, field
 from typing import ClassVar
@@ -29,14 +32,10 @@ import numpy as np
 from .._validation import at_least, finite_array, positive
 from ..errors import GyrocalWarning, InputError
 from ..stillness import find_motion
-from ..units import MAD_TO_SIGMA
-from .polyfit import ar1_covariance, choose_orders, segment_cv, vander
+from .curve import MAX_ORDER, AccelDrift, BlockGrid, TemperaturePolynomial, check_axes, check_curve, fit_sensor
 from .temperature import temperature_course
 
-__all__ = ["MAX_ORDER", "ThermalBias", "ThermalBiasWarning", "fit_thermal_bias"]
-
-#: Highest order PX4 (X0..X3) and ArduPilot (constant + GYR1..GYR3) evaluate.
-MAX_ORDER = 3
+__all__ = ["MAX_ORDER", "AccelDrift", "ThermalBias", "ThermalBiasWarning", "fit_thermal_bias"]
 #: ArduPilot's minimum temperature rise for a calibration [degC].
 MIN_SPAN = 10.0
 
@@ -46,8 +45,8 @@ class ThermalBiasWarning(GyrocalWarning):
 
 
 @dataclass(frozen=True)
-class ThermalBias:
-    """Gyro bias as a polynomial of temperature, per axis, with its uncertainty.
+class ThermalBias(TemperaturePolynomial):
+    """Gyro bias as a polynomial of temperature, per axis, with its uncertainty (and the accelerometer's).
 
     Attributes
     ----------
@@ -70,6 +69,8 @@ class ThermalBias:
     source : dict
         Where the data came from (file, IMU instance, device id), for the record.
     warnings : tuple of str
+    accel : AccelDrift or None
+        The accelerometer offsets' change from ``tref`` over the same range, when fitted.
     """
 
     coefs: np.ndarray
@@ -86,10 +87,11 @@ class ThermalBias:
     fit: dict = field(default_factory=dict)
     source: dict = field(default_factory=dict)
     warnings: tuple[str, ...] = ()
+    accel: AccelDrift | None = None
 
     #: File kind (registered by :mod:`gyrocal.thermal_bias_file`, which holds the document code).
     FORMAT: ClassVar[str] = "gyrocal.thermal-bias"
-    VERSION: ClassVar[int] = 1
+    VERSION: ClassVar[int] = 2
 
     def to_document(self) -> dict:
         """The JSON-ready document (``format: gyrocal.thermal-bias``)."""
@@ -105,67 +107,25 @@ class ThermalBias:
         return from_document(doc, path)
 
     def __post_init__(self):
-        k = MAX_ORDER + 1
-        for name, shape in (("coefs", (3, k)), ("covariance", (3, k, k)), ("cv_rms", (k, 3)),
-                            ("residual_rms", (3,)), ("noise_std", (3,))):
-            arr = finite_array(name, getattr(self, name))
-            if arr.shape != shape:
-                raise InputError(f"{name} must have shape {shape}, got {arr.shape}")
-            arr.setflags(write=False)
-            object.__setattr__(self, name, arr)
-        orders = np.asarray(self.orders, dtype=int)
-        if orders.shape != (3,) or np.any(orders < 0) or np.any(orders > MAX_ORDER):
-            raise InputError(f"orders must be 3 integers in 0..{MAX_ORDER}, got {self.orders!r}")
-        orders.setflags(write=False)
-        object.__setattr__(self, "orders", orders)
-        if not (self.tmin <= self.tref <= self.tmax and self.tmax > self.tmin):
-            raise InputError(f"need tmin <= tref <= tmax and tmax > tmin, got {self.tmin}, {self.tref}, {self.tmax}")
-
-    def clip(self, temp) -> np.ndarray:
-        """Temperatures [degC] clipped to the fitted range, as PX4 clips them."""
-        return np.clip(np.asarray(temp, dtype=float), self.tmin, self.tmax)
+        check_curve(self)
+        if self.accel is not None and not isinstance(self.accel, AccelDrift):
+            raise InputError(f"accel must be an AccelDrift or None, got {type(self.accel).__name__}")
+        if self.accel is not None and (self.accel.tref, self.accel.tmin, self.accel.tmax) != (
+                self.tref, self.tmin, self.tmax):
+            # one INS_TCALn_TMIN/TMAX serves both sensors in ArduPilot: the fits share their range
+            raise InputError("the accelerometer part must cover the gyro's range and reference temperature")
 
     def bias_at(self, temp) -> np.ndarray:
         """Bias (N, 3) [rad/s] at temperatures (N,) [degC], clipped to ``[tmin, tmax]``."""
-        d = self.clip(np.atleast_1d(temp)) - self.tref
-        return vander(d, MAX_ORDER) @ self.coefs.T
-
-    def std_at(self, temp) -> np.ndarray:
-        """1-sigma (N, 3) [rad/s] of :meth:`bias_at`."""
-        X = vander(self.clip(np.atleast_1d(temp)) - self.tref, MAX_ORDER)
-        return np.sqrt(np.maximum(np.einsum("ni,aij,nj->na", X, self.covariance, X), 0.0))
-
-    def coefficients_about(self, t0: float) -> np.ndarray:
-        """Coefficients (3, MAX_ORDER + 1) of the same polynomials in powers of ``(T - t0)``.
-
-        A Taylor shift, exact up to rounding: ``sum_n c_n (T - tref)^n = sum_k c'_k (T - t0)^k``
-        with ``c'_k = sum_{n >= k} c_n C(n, k) (t0 - tref)^(n - k)``. ArduPilot's polynomial is
-        about 35 degC, and PX4's ``TREF`` is written as a float32.
-        """
-        h = float(t0) - self.tref
-        k = MAX_ORDER + 1
-        shift = np.array([[math.comb(n, j) * h ** (n - j) if n >= j else 0.0 for n in range(k)] for j in range(k)])
-        return self.coefs @ shift.T
+        return self.value_at(temp)
 
     def compensate(self, gyro, temp) -> np.ndarray:
         """Readings (N, 3) [rad/s] less the bias at temperatures (N,) [degC]."""
         return finite_array("gyro", gyro, shape_tail=(3,), ndim=2) - self.bias_at(temp)
 
 
-def _blocks(g: np.ndarray, temp: np.ndarray, valid: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
-    """Block means of the readings and of the temperature course, blocks with any invalid temperature dropped."""
-    nb = len(g) // size
-    keep = valid[: nb * size].reshape(nb, size).all(axis=1)
-    gm = g[: nb * size].reshape(nb, size, 3).mean(axis=1)[keep]
-    tm = np.where(valid, temp, 0.0)[: nb * size].reshape(nb, size).mean(axis=1)[keep]
-    return gm, tm
-
-
 def _check_input(g, temp, fs, min_span) -> None:
-    for j, axis in enumerate("xyz"):
-        if g[:, j].min() == g[:, j].max():
-            raise InputError(f"gyro axis {axis} reads {float(g[0, j]):g} in every sample: a constant column holds "
-                             "no bias to fit (a dead sensor, or the wrong column mapped?)")
+    check_axes(g, "gyro")
     if temp.min() == temp.max() or np.ptp(temp) < min_span:
         raise InputError(f"the log spans only {np.ptp(temp):.1f} degC ({temp.min():.1f} to {temp.max():.1f}); a "
                          f"bias-versus-temperature fit needs at least {min_span:g} degC: cool the board first "
@@ -176,9 +136,28 @@ def _check_input(g, temp, fs, min_span) -> None:
                          "end: record it again untouched, or cut the log to a still stretch")
 
 
+def _grid(course, n: int, size: int, segments: int, min_span: float, fs: float) -> tuple[BlockGrid, float, float]:
+    """The blocks with a known temperature, their scaled temperature and segment; and the range they cover."""
+    nb = n // size
+    keep = course.valid[: nb * size].reshape(nb, size).all(axis=1)
+    tm = np.where(course.valid, course.temp, 0.0)[: nb * size].reshape(nb, size).mean(axis=1)[keep]
+    if len(tm) < 4 * (MAX_ORDER + 1):
+        raise InputError(f"the log holds {len(tm)} blocks of {size / fs:g} s; a thermal-bias fit needs at least "
+                         f"{4 * (MAX_ORDER + 1)}: log longer")
+    tmin, tmax = float(tm.min()), float(tm.max())
+    if tmax - tmin < min_span:
+        raise InputError(f"the temperature is known well enough over {tmin:.1f} to {tmax:.1f} degC only (readings in "
+                         f"steps of {course.quantum:g} degC); a bias-versus-temperature fit needs {min_span:g} degC")
+    tref, half = 0.5 * (tmin + tmax), 0.5 * (tmax - tmin)
+    u = (tm - tref) / half
+    seg = np.minimum(((u + 1) / 2 * segments).astype(int), segments - 1)
+    return BlockGrid(size, keep, u, seg, tref, half), tmin, tmax
+
+
 def fit_thermal_bias(gyro, temp, sample_rate: float, *, max_order: int = MAX_ORDER, min_span: float = MIN_SPAN,
-                     block_s: float = 5.0, segments: int = 8, source: dict | None = None) -> ThermalBias:
-    """Fit the gyro bias against temperature on a still, warming log.
+                     block_s: float = 5.0, segments: int = 8, source: dict | None = None,
+                     accel=None) -> ThermalBias:
+    """Fit the gyro bias (and the accelerometer's offset change) against temperature on a still, warming log.
 
     Parameters
     ----------
@@ -199,6 +178,9 @@ def fit_thermal_bias(gyro, temp, sample_rate: float, *, max_order: int = MAX_ORD
         Temperature segments for the order choice (each left out in turn).
     source : dict, optional
         Where the data came from, recorded in the result.
+    accel : array_like, shape (N, 3), optional
+        Accelerometer readings [m/s^2] of the same samples: their change with temperature from
+        ``tref`` is fitted the same way (:class:`.curve.AccelDrift`).
 
     Raises
     ------
@@ -209,70 +191,28 @@ def fit_thermal_bias(gyro, temp, sample_rate: float, *, max_order: int = MAX_ORD
     t_raw = finite_array("temp", temp, ndim=1)
     if len(t_raw) != len(g):
         raise InputError(f"temp has {len(t_raw)} samples but gyro has {len(g)}")
+    a = None if accel is None else finite_array("accel", accel, shape_tail=(3,), ndim=2)
+    if a is not None and len(a) != len(g):
+        raise InputError(f"accel has {len(a)} samples but gyro has {len(g)}")
     fs = positive("sample_rate", sample_rate)
     if not 0 <= int(max_order) <= MAX_ORDER:
         raise InputError(f"{{param}} must be 0..{MAX_ORDER} (PX4 and ArduPilot evaluate cubics), got {max_order!r}",
                          param="max_order", value=max_order)
     _check_input(g, t_raw, fs, at_least("min_span", min_span, 0.0, " degC"))
+    if a is not None:
+        check_axes(a, "accelerometer")
     size = max(10, int(round(block_s * fs)))
     course = temperature_course(t_raw, fs)
-    gm, tm = _blocks(g, course.temp, course.valid, size)
-    if len(gm) < 4 * (MAX_ORDER + 1):
-        raise InputError(f"the log holds {len(gm)} blocks of {size / fs:g} s; a thermal-bias fit needs at least "
-                         f"{4 * (MAX_ORDER + 1)}: log longer")
-    tmin, tmax = float(tm.min()), float(tm.max())
-    if tmax - tmin < min_span:
-        raise InputError(f"the temperature is known well enough over {tmin:.1f} to {tmax:.1f} degC only (readings in "
-                         f"steps of {course.quantum:g} degC); a bias-versus-temperature fit needs {min_span:g} degC")
-    tref, half = 0.5 * (tmin + tmax), 0.5 * (tmax - tmin)
-    u = (tm - tref) / half
-    seg = np.minimum(((u + 1) / 2 * segments).astype(int), segments - 1)
-    cv = np.full((MAX_ORDER + 1, 3), np.nan)
-    cv[: max_order + 1] = segment_cv(u, gm, seg, int(max_order))
-    orders = choose_orders(cv[: max_order + 1], len(np.unique(seg)))
-    d = np.diff(g[: len(g) // size * size].reshape(-1, size, 3), axis=1).reshape(-1, 3)
-    noise = MAD_TO_SIGMA * np.median(np.abs(d - np.median(d, axis=0)), axis=0) / math.sqrt(2.0)  # white, robust to drift
-    coefs, cov, resid_rms, wander = _fit_axes(u, gm, orders, noise**2 / size, half)
-    found = _quality(resid_rms, noise, size, cv, orders)
+    grid, tmin, tmax = _grid(course, len(g), size, segments, min_span, fs)
+    gf = fit_sensor(g, grid, int(max_order))
+    af = None if a is None else fit_sensor(a, grid, int(max_order), label="accelerometer ", relative=True)
+    found = gf.warnings + ([] if af is None else af.warnings)
     for message in found:
         warnings.warn(message, ThermalBiasWarning, stacklevel=2)
-    fit = {"blocks": len(gm), "block_s": size / fs, "segments": int(segments), "max_order": int(max_order),
-           "min_span_degC": min_span, "temperature": course.method,
-           "noise_model": wander}
-    return ThermalBias(coefs, cov, orders, tref, tmin, tmax, np.nan_to_num(cv, nan=0.0), resid_rms, noise, fs,
-                       len(g) / fs, fit, dict(source or {}), tuple(found))
-
-
-def _fit_axes(u, gm, orders, white_var, half):
-    """Each axis's polynomial of its order, in powers of (T - tref), with its covariance."""
-    coefs = np.zeros((3, MAX_ORDER + 1))
-    cov = np.zeros((3, MAX_ORDER + 1, MAX_ORDER + 1))
-    resid_rms = np.empty(3)
-    wander = []
-    for a, p in enumerate(orders):
-        X = vander(u, int(p))
-        c, *_ = np.linalg.lstsq(X, gm[:, a], rcond=None)
-        r = gm[:, a] - X @ c
-        C, model = ar1_covariance(X, r, white_var[a])
-        wander.append({k: float(v) for k, v in model.items()})
-        scale = half ** -np.arange(p + 1)  # from powers of u to powers of (T - tref)
-        coefs[a, : p + 1] = c * scale
-        cov[a, : p + 1, : p + 1] = C * np.outer(scale, scale)
-        resid_rms[a] = math.sqrt(np.mean(r**2))
-    return coefs, cov, resid_rms, wander
-
-
-def _quality(resid_rms, noise, size, cv, orders) -> list[str]:
-    """Warnings where the residuals or the left-out predictions exceed what the noise explains."""
-    found = []
-    white = noise / math.sqrt(size)
-    for a, axis in enumerate("xyz"):
-        ratio = resid_rms[a] / max(white[a], 1e-300)
-        if ratio > 3:
-            found.append(f"axis {axis}: the block residuals are {ratio:.1f}x the white noise (bias instability or "
-                         "temperature lag); the 1-sigma is taken from the residuals")
-        held = cv[orders[a], a] / max(resid_rms[a], 1e-300)
-        if held > 3:
-            found.append(f"axis {axis}: predicting each temperature segment from the others errs {held:.1f}x the "
-                         "residual; the curve is uncertain between and beyond the data")
-    return found
+    fit = {"blocks": int(grid.keep.sum()), "block_s": size / fs, "segments": int(segments),
+           "max_order": int(max_order), "min_span_degC": min_span, "temperature": course.method,
+           "noise_model": gf.noise_model}
+    drift = None if af is None else AccelDrift(af.coefs, af.covariance, af.orders, grid.tref, tmin, tmax, af.cv_rms,
+                                               af.residual_rms, af.noise_std, {"noise_model": af.noise_model})
+    return ThermalBias(gf.coefs, gf.covariance, gf.orders, grid.tref, tmin, tmax, gf.cv_rms, gf.residual_rms,
+                       gf.noise_std, fs, len(g) / fs, fit, dict(source or {}), tuple(found), drift)

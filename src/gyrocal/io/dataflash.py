@@ -7,7 +7,9 @@ temperature correction (when ``INS_TCALn_ENABLE`` is 1) and the offsets ``INS_GY
 then rotates by ``AHRS_ORIENTATION`` (``AP_InertialSensor_Backend::_rotate_and_correct_gyro``).
 As ArduPilot's ``Tools/scripts/tempcal_IMU.py`` does, this reader undoes the rotation and
 the temperature correction from the log's ``PARM`` messages, and adds the offsets back, so
-the gyro columns are the raw readings in the frame the ``INS_TCAL`` parameters apply in.
+the gyro columns are the raw readings in the frame the ``INS_TCAL`` parameters apply in. The
+accelerometer likewise (``_rotate_and_correct_accel``: the ``ACC`` temperature terms about
+``INS_ACCn_CALTEMP``, then ``INS_ACCOFFS`` and ``INS_ACCSCAL``).
 """
 
 from __future__ import annotations
@@ -81,19 +83,34 @@ def _orientation(rot_id: int) -> np.ndarray:
     return np.array([[c.x, c.y, c.z] for c in cols]).T
 
 
-def _tcal(params: dict, n: int, temp: np.ndarray) -> np.ndarray | None:
-    """What ``correct_sensor`` subtracted (N, 3) [rad/s] for IMU number n, or None when it is off."""
+def _tcal(params: dict, n: int, temp: np.ndarray, sensor: str = "GYR") -> np.ndarray | None:
+    """What ``correct_sensor`` subtracted (N, 3) for IMU number n (GYR [rad/s] or ACC [m/s^2]), or None when off."""
     if params.get(f"INS_TCAL{n}_ENABLE") != 1:
         return None
     lo, hi = params.get(f"INS_TCAL{n}_TMIN", 0.0), params.get(f"INS_TCAL{n}_TMAX", 70.0)
-    c = np.array([[params.get(f"INS_TCAL{n}_GYR{k}_{ax}", 0.0) for ax in "XYZ"] for k in (1, 2, 3)]) * 1e-6
+    c = np.array([[params.get(f"INS_TCAL{n}_{sensor}{k}_{ax}", 0.0) for ax in "XYZ"] for k in (1, 2, 3)]) * 1e-6
 
     def poly(x):
         x = np.asarray(x, float)[..., None]
         return (c[0] + (c[1] + c[2] * x) * x) * x
 
-    cal = np.clip(params.get(f"INS_GYR{n}_CALTEMP", lo), lo, hi)
+    cal = np.clip(params.get(f"INS_{sensor}{n}_CALTEMP", lo), lo, hi)
     return poly(np.clip(temp, lo, hi) - 35.0) - poly(cal - 35.0)
+
+
+def _raw_accel(params: dict, n: int, acc: np.ndarray, temp: np.ndarray, undone: list) -> np.ndarray:
+    """The accelerometer before ``_rotate_and_correct_accel``'s temperature correction, offsets and scale."""
+    suffix = "" if n == 1 else str(n)
+    scale = np.array([params.get(f"INS_ACC{suffix}SCAL_{ax}", 1.0) or 1.0 for ax in "XYZ"])
+    offsets = np.array([params.get(f"INS_ACC{suffix}OFFS_{ax}", 0.0) for ax in "XYZ"])
+    tcal = _tcal(params, n, temp, "ACC") if np.isfinite(temp).all() else None
+    if np.any(scale != 1) or np.any(offsets != 0):
+        acc = acc / scale + offsets
+        undone.append(f"INS_ACC{suffix}SCAL, INS_ACC{suffix}OFFS")
+    if tcal is not None and np.any(tcal != 0):
+        acc = acc + tcal
+        undone.append(f"INS_TCAL{n} accelerometer temperature correction")
+    return acc
 
 
 def read_dataflash_columns(path: str | os.PathLike) -> dict[int, tuple[dict, dict, dict]]:
@@ -133,6 +150,7 @@ def read_dataflash_columns(path: str | os.PathLike) -> dict[int, tuple[dict, dic
         if np.any(offsets != 0):
             gyro = gyro + offsets
             undone.append(offs)
+        acc = _raw_accel(params, n, acc, temp, undone)
         data = {"t": a[:, 0] * 1e-6, "gx": gyro[:, 0], "gy": gyro[:, 1], "gz": gyro[:, 2],
                 "ax": acc[:, 0], "ay": acc[:, 1], "az": acc[:, 2]}
         if np.isfinite(temp).all():
