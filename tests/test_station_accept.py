@@ -139,7 +139,7 @@ def test_calibrate_records_the_unit_and_exits_one_on_a_fail(tmp_path):
 
 def test_station_flags_are_checked_before_the_fit(tmp_path):
     assert "--store keeps records per unit" in refused("calibrate", "--example", "--store", tmp_path / "s.db")
-    assert "cannot hold '/'" in refused("calibrate", "--example", "--unit", "a/b")
+    assert "holds '/', which a file name cannot hold" in refused("calibrate", "--example", "--unit", "a/b")
     limits = tmp_path / "k.toml"
     limits.write_text("[limits.k]\nmax = 2\n")
     assert "not found" in refused("accept", tmp_path / "none.json", "--limits", limits)

@@ -74,7 +74,7 @@ def test_without_limits_every_calibrated_unit_exits_zero(lot, tmp_path):
     ("file,serial,job\nx.csv,S1,calibrate\n", "lacks the column(s) args"),
     ("file,serial,job,args\nx.csv,S1,fit,\n", "unknown job 'fit'"),
     ("file,serial,job,args\nx.csv,S1,calibrate,--unit S2\n", "args sets --unit"),
-    ("file,serial,job,args\nx.csv,a/b,calibrate,\n", "cannot hold '/'"),
+    ("file,serial,job,args\nx.csv,a/b,calibrate,\n", "holds '/', which a file name cannot hold"),
     ("file,serial,job,args,colour\nx.csv,S1,calibrate,,red\n", "unknown column 'colour'"),
     ("file,serial,job,args\n", "has no rows"),
 ])

@@ -11,7 +11,6 @@ The ``unit`` section of a result file::
 from __future__ import annotations
 
 import hashlib
-import re
 from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
@@ -21,23 +20,14 @@ from ..errors import InputError
 
 __all__ = ["Identity", "check_serial", "sha256_of", "unit_section", "utc_now"]
 
-# what a file name on Windows, macOS and Linux can hold, and no path separators
-_BAD_SERIAL = re.compile(r'[\x00-\x1f\x7f/\\:*?"<>|]')
-
-
 def check_serial(serial: str, flag: str = "--unit") -> str:
-    """`serial` stripped, or an error naming the character a file name cannot hold."""
-    text = str(serial).strip()
-    if not text:
-        raise InputError(f"{flag} needs a serial number, got an empty one")
-    bad = _BAD_SERIAL.search(text)
-    if bad or text in (".", ".."):
-        what = repr(bad.group()) if bad else repr(text)
-        raise InputError(f"{flag} {text!r}: a serial number cannot hold {what} (it names files and records); "
-                         "use letters, digits, '-', '_' or '.'")
-    if len(text) > 128:
-        raise InputError(f"{flag}: a serial number of {len(text)} characters is too long (at most 128)")
-    return text
+    """`serial` without surrounding blanks, checked by the store's rule (a file name must hold it)."""
+    from ..store.records import check_serial as store_rule
+
+    try:
+        return store_rule(str(serial).strip())
+    except InputError as exc:
+        raise InputError(f"{flag}: {exc}") from None
 
 
 def _procedure(text: str | None) -> dict | None:
