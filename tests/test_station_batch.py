@@ -144,3 +144,59 @@ def test_apply_takes_the_calibration_in_force_from_the_store(lot, tmp_path):
     assert "--unit SERIAL" in refused("apply", "--store", store, recording, "-o", tmp_path / "x.csv")
     assert "give only the recording" in refused("apply", "--store", store, "--unit", "SN-P", tmp_path / "a.json",
                                                 recording, "-o", tmp_path / "x.csv")
+
+
+def test_ctrl_c_keeps_what_finished_and_leaves_nothing_half_written(lot, tmp_path):
+    """SIGINT to a running batch: one line, exit 2; every stored record has its result file and no temporary
+    file is left (reference: the store's own count against the folder)."""
+    import signal
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    rows = []
+    for i in range(12):  # distinct inputs (a rerun check is by content)
+        copy = tmp_path / f"u{i}.csv"
+        copy.write_text(f"# copy {i}\n" + (lot / "a.csv").read_text())
+        rows.append(f"{copy},SN-{i},calibrate,{SPEED},bench-1")
+    manifest = _manifest(tmp_path, rows)
+    store = tmp_path / "s.db"
+    proc = subprocess.Popen([str(Path(sys.executable).with_name("gyrocal")), "batch", str(manifest), "--store",
+                             str(store)], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 120
+        while not (store.exists() and _count(store) >= 1):
+            assert proc.poll() is None and time.monotonic() < deadline, "no row finished"
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(timeout=120) == 2
+        lines = proc.stderr.read().strip().splitlines()
+    finally:
+        proc.kill()
+        proc.stderr.close()
+    assert len(lines) == 1 and lines[0].startswith("error: interrupted:"), lines
+    results = sorted((tmp_path / "results").iterdir())
+    assert all(p.suffix == ".json" and ".tmp" not in p.name for p in results)
+    assert 1 <= _count(store) == len(results) < 12
+
+
+def _count(store) -> int:
+    with open_store(store) as st:
+        return st.count()
+
+
+def test_a_store_of_a_newer_schema_is_refused_by_every_command(lot, tmp_path):
+    """A store a newer gyrocal migrated (its alembic_version stamped ahead, with sqlite3 directly): refused in one
+    line, and nothing is written to it."""
+    import sqlite3
+
+    store = tmp_path / "s.db"
+    with open_store(store):
+        pass
+    with sqlite3.connect(store) as connection:
+        connection.execute("UPDATE alembic_version SET version_num = '9999'")
+    for args in (("store", "list", "--store", store),
+                 ("calibrate", lot / "a.csv", *SPEED.split(), "--unit", "SN-N", "--store", store)):
+        assert "newer than this gyrocal" in refused(*args)
+    with sqlite3.connect(store) as connection:
+        assert connection.execute("SELECT count(*) FROM records").fetchone()[0] == 0

@@ -90,6 +90,9 @@ class StationFlags:
             from ..station.limits import read_limits
 
             read_limits(self.limits)
+        if self.store is not None:  # unreachable, or of a newer schema: say so before the work, not after
+            with _open(self.store):
+                pass
 
     def identity(self):
         if self.unit is None:

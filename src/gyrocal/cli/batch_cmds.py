@@ -32,6 +32,13 @@ class Outcome:
     failed: tuple[str, ...] = ()
 
 
+def _ignore_interrupt() -> None:
+    """Workers finish the row they are on when Ctrl-C comes: the batch itself stops handing out rows."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 def _run_row(argv: list[str], job: str, args: str) -> tuple[int, str]:
     """Run one command in this (worker) process: its exit code and the last line it wrote to stderr."""
     from ._station import batch_job
@@ -103,7 +110,7 @@ def _run(todo, shas, url, limits, out_dir, jobs: int, store) -> list[Outcome]:
 
     # spawned, not forked: a worker must not inherit this process's open store connections
     context = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=jobs, mp_context=context) as pool, \
+    with ProcessPoolExecutor(max_workers=jobs, mp_context=context, initializer=_ignore_interrupt) as pool, \
             Progress(console=console, transient=True) as bar:
         task = bar.add_task("calibrating", total=len(todo))
         futures = {pool.submit(_run_row, _argv(r, url, limits, out_dir, shas[r.line]), r.job, r.args): r
@@ -115,9 +122,11 @@ def _run(todo, shas, url, limits, out_dir, jobs: int, store) -> list[Outcome]:
                 outcomes.append(_finished(row, code, line, out_dir, shas[row.line], store, limits is not None))
                 bar.advance(task)
         except KeyboardInterrupt:
-            pool.shutdown(wait=True, cancel_futures=True)
-            raise InputError(f"interrupted: {len(outcomes)} of {len(todo)} new row(s) finished and are stored; "
-                             "nothing was left half written; run the batch again to do the rest") from None
+            bar.stop()
+            pool.shutdown(wait=True, cancel_futures=True)  # the rows being run finish and store themselves
+            raise InputError(f"interrupted: {len(outcomes)} of {len(todo)} new row(s) were done, and the ones "
+                             "running finished and are stored; nothing was left half written; run the batch again "
+                             "to do the rest") from None
     return outcomes
 
 
