@@ -28,7 +28,7 @@ from .estimators import FitResult, make_estimator
 from .fit_checks import check_fit, single_turn_warnings, with_common_scale
 from .observations import Observation, ObservationSet
 from .observed import quiet_noise
-from .plausibility import Context
+from .plausibility import Context, implausible
 from .quality import GoodnessOfFit
 from .recording import Recording
 from .screening import reference_variances, require_constant_rate, screen_gaps
@@ -69,6 +69,9 @@ class CalibrationRun:
         What the self-checks found wrong or doubtful (fit quality, plausibility of k).
     notes : tuple of str
         What they found worth saying (the sensitivity counts imply).
+    implausible : str or None
+        Why the scale factors are not believable (:func:`gyrocal.plausibility.implausible`): the commands
+        refuse to write them unless told to accept them; None when plausible or the self-checks were off.
     """
 
     calibration: Calibration
@@ -81,6 +84,7 @@ class CalibrationRun:
     time_base: TimeBase | None = None
     warnings: tuple[str, ...] = ()
     notes: tuple[str, ...] = ()
+    implausible: str | None = None
 
     def parameters(self) -> list[tuple[str, float, float, str]]:
         """``(name, value, 1-sigma, unit)`` of k and b in user units (see :func:`parameter_rows`)."""
@@ -262,7 +266,7 @@ def calibrate(
     if checks and uses_static and reference == "angle":  # a wandering axis: the integral is not the rotation
         observations, obs_set, fit = follow_wander(rec, rec.t if times is None else times, used, observations,
                                                    obs_set, fit, estimator)
-    quality, warnings, notes = None, [], []
+    quality, warnings, notes, refusal = None, [], [], None
     if checks:
         ctx = Context(units=input_units, counts_scale=rec.units == "counts", reference=reference,
                       declared=value if windows is None or reference == "speed" else math.nan,
@@ -271,6 +275,7 @@ def calibrate(
         scale = input_scale(input_units, rec.sensitivity, out_units)
         fit, obs_set, quality, warnings, notes = check_fit(fit, obs_set, estimator, [_label(w) for w in used],
                                                            reference=reference, ctx=ctx, input_scale=scale)
+        refusal = implausible(fit.model.k, ctx)
         warnings[1 if quality.warnings else 0:0] = list(seg.warnings) + single_turn_warnings(
             [w.axis for w in used if w.kind == "rotation"], reference, None if windows and reference == "angle" else value)
         if reference_sd:
@@ -293,7 +298,8 @@ def calibrate(
         # every warning and note printed goes in the file too: a flagged calibration must not look clean there
         cal = dataclasses.replace(cal, fit={**quality.to_document(), "warnings": list(warnings), "notes": list(notes)},
                                   observed=_observed(rec, tb, fit.noise_std, cal.input_scale, input_units))
-    return CalibrationRun(cal, fit, seg, observations, reference, value, quality, tb, tuple(warnings), tuple(notes))
+    return CalibrationRun(cal, fit, seg, observations, reference, value, quality, tb, tuple(warnings), tuple(notes),
+                          refusal)
 
 
 def _observed(rec: Recording, tb: TimeBase, noise_std, input_scale: float, input_units: str) -> dict:

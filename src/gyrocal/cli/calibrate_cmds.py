@@ -18,6 +18,7 @@ import typer
 
 from ..choices import Method
 from ..errors import GyrocalError, InputError
+from ._options import AcceptImplausible, judge_plausible
 from ._outputs import check_output, same_document
 from ._reading import READING, read_from_flags, required_units
 from ._references import density_to_internal, noise_to_internal, rate_unit_of, reference_of
@@ -194,6 +195,7 @@ def calibrate(
     output: Output = None,
     plot: PlotPath = None,
     force: Force = False,
+    accept_implausible: AcceptImplausible = False,
     example: Annotated[bool, typer.Option(
         "--example", help="Run on the bundled simulated MPU9250 servo recording (deg/s, --speed 60 unless "
         "--angle or --windows).")] = False,
@@ -232,7 +234,7 @@ def calibrate(
                           output_units=rate_unit, reference_sd=ref_sd)
     cal = _with_notes(run.calibration, read_notes)
     inputs = (Path(recording), windows)
-    doc, verdict = finish(cal.to_document(), flags, inputs=inputs)
+    doc, verdict = finish(judge_plausible(cal.to_document(), run.implausible, accept_implausible), flags, inputs=inputs)
     check_output(output, inputs=inputs, force=force, replaceable=same_document(doc),
                  holds="a different calibration or another file")
     check_output(plot, flag="--plot", inputs=inputs + (output,), outputs=(output,), force=True)

@@ -8,6 +8,7 @@ from typing import Annotated, Optional
 
 import typer
 
+from ._options import AcceptImplausible, judge_plausible
 from ._outputs import check_output, json_format
 from ._reading import READING, read_from_flags, required_units
 from ._station import StationFlags, conclude, finish, station_flags, write_and_store
@@ -46,6 +47,19 @@ def _summary(tb, unit: str, factor: float):
     return table
 
 
+def _implausible(tb, rec, log: Path) -> str | None:
+    """The plausibility rule on a still log whose unit was declared (a flight log's unit is its format's)."""
+    import numpy as np
+
+    from ..io.flightlog import flight_log_kind
+    from ..plausibility import still_units
+
+    if log.is_file() and flight_log_kind(log) is not None or rec.source_units not in ("deg/s", "rad/s"):
+        return None
+    deg = 180 / math.pi
+    return still_units(tb.bias_at([tb.tref])[0] * deg, np.asarray(tb.noise_std) * deg, rec.source_units)
+
+
 @app.command("thermal-bias")
 @station_flags
 def thermal_bias(
@@ -64,6 +78,7 @@ def thermal_bias(
         "--min-span", help="Smallest temperature span accepted [degC] (ArduPilot's minimum: 10).")] = 10.0,
     force: Annotated[bool, typer.Option("--force", help="Replace an -o file that is not a thermal-bias file.")]
     = False,
+    accept_implausible: AcceptImplausible = False,
     flags: StationFlags = StationFlags(),
 ) -> None:
     """Fit gyro bias against temperature for PX4 and ArduPilot (export with --format px4 or ardupilot)."""
@@ -80,7 +95,8 @@ def thermal_bias(
     fs = (len(rec) - 1) / float(rec.t[-1] - rec.t[0]) if rec.has_time else rec.sample_rate
     source["units"] = rec.source_units
     tb = fit_thermal_bias(rec.gyro, rec.temp, fs, max_order=max_order, min_span=min_span, source=source)
-    doc, verdict = finish(tb.to_document(), flags, inputs=(log,), device_id=source.get("device_id"))
+    doc = judge_plausible(tb.to_document(), _implausible(tb, rec, log), accept_implausible)
+    doc, verdict = finish(doc, flags, inputs=(log,), device_id=source.get("device_id"))
     record = write_and_store(doc, flags, output, verdict, inputs=(log,), kind="thermal-bias", job="thermal-bias")
     shown = rec.source_units if rec.source_units in ("rad/s", "deg/s") else (output_units or "deg/s")
     console.print(_summary(tb, shown, 1.0 / unit_factor(shown)))
