@@ -221,17 +221,18 @@ def far_scale(k, unit: str, cause: str) -> str | None:
             f"{cause.format(', '.join(a for a, _ in far))}, or the unit is wrong{hint}")
 
 
-def still_units(bias, noise, unit: str) -> str | None:
-    """The diagnosis for a still log whose bias or per-sample noise (3,) [deg/s, read as declared in `unit`] no
-    MEMS gyro shows, or None: a zero-rate offset beyond 50 deg/s or noise beyond 5 deg/s (deg/s read as rad/s),
-    or noise below 0.001 deg/s on every axis (rad/s read as deg/s; no MEMS gyro is that quiet)."""
-    bias, noise = np.abs(np.asarray(bias, dtype=float)), np.asarray(noise, dtype=float)
-    shown = (f"its bias reads {', '.join(f'{v:.3g}' for v in bias)} deg/s and its noise "
-             f"{', '.join(f'{v:.3g}' for v in noise)} deg/s per sample as declared in {unit}")
-    if np.any(bias > 50) or np.any(noise > 5):
-        return (f"a still MEMS gyro's zero-rate offset stays within about 20 deg/s and its noise within a few deg/s, "
-                f"but {shown}: is the unit right (deg/s data declared rad/s read 57.3 times large)?")
-    if np.all((noise > 0) & (noise < 1e-3)):
-        return (f"no MEMS gyro is quieter than about 0.001 deg/s per sample, but {shown}: is the unit right (rad/s "
+def still_units(bias, density, unit: str) -> str | None:
+    """The diagnosis for a still log whose bias [deg/s] or white-noise density [deg/s/sqrt(Hz)] (3,), read as
+    declared in `unit`, no MEMS gyro shows, or None: a zero-rate offset beyond 50 deg/s or a density beyond
+    0.5 (deg/s read as rad/s), or a density below 2e-4 on every axis (rad/s read as deg/s: the quietest MEMS
+    gyros, ADIS16495-class, reach 0.0015, and a chip's filter lowers the estimate by a few times at most)."""
+    bias, density = np.abs(np.asarray(bias, dtype=float)), np.asarray(density, dtype=float)
+    shown = (f"its bias reads {', '.join(f'{v:.3g}' for v in bias)} deg/s and its noise density "
+             f"{', '.join(f'{v:.3g}' for v in density)} deg/s/sqrt(Hz) as declared in {unit}")
+    if np.any(bias > 50) or np.any(density > 0.5):
+        return (f"a still MEMS gyro's zero-rate offset stays within about 20 deg/s and its noise density below 0.1 "
+                f"deg/s/sqrt(Hz), but {shown}: is the unit right (deg/s data declared rad/s read 57.3 times large)?")
+    if np.all((density > 0) & (density < 2e-4)):
+        return (f"no MEMS gyro is quieter than about 0.0015 deg/s/sqrt(Hz), but {shown}: is the unit right (rad/s "
                 "data declared deg/s read 57.3 times small)?")
     return None

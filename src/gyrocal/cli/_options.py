@@ -135,7 +135,8 @@ AcceptImplausible = Annotated[bool, typer.Option(
 
 def judge_plausible(doc: dict, diagnosis: str | None, accept: bool) -> dict:
     """The result document `doc`, refused (one line, exit 2, before anything is written) when `diagnosis` says it
-    is implausible, unless `accept`: then with the diagnosis among its warnings (the fit's, or the file's own)."""
+    is implausible, unless `accept`: then with the diagnosis among its warnings (the file's own, the fit's, or the
+    settings' for a thermal table without a fit section)."""
     if diagnosis is None:
         return doc
     if not accept:
@@ -146,8 +147,8 @@ def judge_plausible(doc: dict, diagnosis: str | None, accept: bool) -> dict:
     text = f"written with --accept-implausible: {diagnosis}"
     warn(text)
     fit = doc.get("fit")
-    if isinstance(fit, dict):
-        return {**doc, "fit": {**fit, "warnings": list(fit.get("warnings") or []) + [text]}}
-    if isinstance(doc.get("warnings"), list):
+    if isinstance(doc.get("warnings"), list):  # the file's own warnings (thermal-bias)
         return {**doc, "warnings": doc["warnings"] + [text]}
+    if isinstance(fit, dict):  # a calibration's fit section
+        return {**doc, "fit": {**fit, "warnings": list(fit.get("warnings") or []) + [text]}}
     return {**doc, "settings": {**(doc.get("settings") or {}), "warnings": [text]}}

@@ -47,7 +47,7 @@ def _summary(tb, unit: str, factor: float):
     return table
 
 
-def _implausible(tb, rec, log: Path) -> str | None:
+def _implausible(tb, rec, log: Path, fs: float) -> str | None:
     """The plausibility rule on a still log whose unit was declared (a flight log's unit is its format's)."""
     import numpy as np
 
@@ -57,7 +57,7 @@ def _implausible(tb, rec, log: Path) -> str | None:
     if log.is_file() and flight_log_kind(log) is not None or rec.source_units not in ("deg/s", "rad/s"):
         return None
     deg = 180 / math.pi
-    return still_units(tb.bias_at([tb.tref])[0] * deg, np.asarray(tb.noise_std) * deg, rec.source_units)
+    return still_units(tb.bias_at([tb.tref])[0] * deg, np.asarray(tb.noise_std) * deg / math.sqrt(fs), rec.source_units)
 
 
 @app.command("thermal-bias")
@@ -95,7 +95,7 @@ def thermal_bias(
     fs = (len(rec) - 1) / float(rec.t[-1] - rec.t[0]) if rec.has_time else rec.sample_rate
     source["units"] = rec.source_units
     tb = fit_thermal_bias(rec.gyro, rec.temp, fs, max_order=max_order, min_span=min_span, source=source)
-    doc = judge_plausible(tb.to_document(), _implausible(tb, rec, log), accept_implausible)
+    doc = judge_plausible(tb.to_document(), _implausible(tb, rec, log, fs), accept_implausible)
     doc, verdict = finish(doc, flags, inputs=(log,), device_id=source.get("device_id"))
     record = write_and_store(doc, flags, output, verdict, inputs=(log,), kind="thermal-bias", job="thermal-bias")
     shown = rec.source_units if rec.source_units in ("rad/s", "deg/s") else (output_units or "deg/s")
