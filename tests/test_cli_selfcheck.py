@@ -68,10 +68,17 @@ def test_a_wrong_sample_rate_is_named_in_a_warning(tmp_path, rng):
     path = tmp_path / "log.csv"
     write_recording(path, Recording.from_rate(rec.gyro, 20.0), units="deg/s")
     np.savetxt(path, np.degrees(rec.gyro), delimiter=",", header="gx,gy,gz", comments="")  # no time column
-    code, out, err = invoke("calibrate", path, "--units", "deg/s", "--sample-rate", "25", "--angle", "360")
+    out_file = tmp_path / "cal.json"
+    line = refused("calibrate", path, "--units", "deg/s", "--sample-rate", "25", "--angle", "360", "-o", out_file)
+    assert re.search(r"every turn reads 20 % short .* is the sample rate 20 Hz rather than the 25 Hz declared\\?", line)
+    assert not out_file.exists()
+    # the same data accepted as they are: exit 0, the diagnosis printed and in the file
+    code, out, err = invoke("calibrate", path, "--units", "deg/s", "--sample-rate", "25", "--angle", "360", "-o",
+                            out_file, "--accept-implausible")
     assert code == 0
     assert re.search(r"warning: every turn reads 20 % short .* is the sample rate 20 Hz rather than the 25 Hz "
                      "declared\\?", err.replace("\n", " "))
+    assert any("--accept-implausible" in w for w in json.loads(out_file.read_text())["fit"]["warnings"])
 
 
 def test_refusals_are_one_line(tmp_path, rng):

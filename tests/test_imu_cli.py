@@ -237,12 +237,20 @@ def test_accelerometer_log_on_other_stamps_is_interpolated_onto_the_gyro(tmp_pat
 
 def test_a_wrong_declared_unit_is_pointed_out(session, tmp_path):
     """deg/s data declared as rad/s and m/s^2 data declared as g: the fit still closes, with scale factors near
-    1/57.3 and 1/9.8, and a warning names each unit."""
+    1/57.3 and 1/9.8; the result is refused (exit 2, nothing written) naming each unit, as calibrate refuses it,
+    and written with the warning in the file under --accept-implausible."""
     rec, _, _, _ = session
-    code, _, err = invoke("imu", rec, "--units", "rad/s", "--no-unit-check", "--accel-units", "g")
+    out = tmp_path / "wrong.json"
+    line = refused("imu", rec, "--units", "rad/s", "--no-unit-check", "--accel-units", "g", "-o", out)
+    assert "implausible result, nothing written" in line and "--accept-implausible" in line and not out.exists()
+    assert "is --units rad/s right? (a factor 1/57.3: data in deg/s read as rad/s)" in line
+    assert "is --accel-units g right? (a factor 1/9.81: data in m/s^2 read as g)" in line
+    code, _, err = invoke("imu", rec, "--units", "rad/s", "--no-unit-check", "--accel-units", "g", "-o", out,
+                          "--accept-implausible")
     assert code == 0, err
     assert "is --units rad/s right? (a factor 1/57.3: data in deg/s read as rad/s)" in err
-    assert "is --accel-units g right? (a factor 1/9.81: data in m/s^2 read as g)" in err
+    assert any(w.startswith("written with --accept-implausible: ") and "a factor 1/57.3" in w
+               for w in json.loads(out.read_text())["fit"]["warnings"])
     # the units right and an output unit of its own: the correction is 57.3 deg/s per rad/s, and no warning
     data = read_recording(rec, units="deg/s", accel_units="m/s^2")
     as_rad = tmp_path / "rad.csv"

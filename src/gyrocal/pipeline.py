@@ -28,11 +28,11 @@ from .estimators import FitResult, make_estimator
 from .fit_checks import check_fit, single_turn_warnings, with_common_scale
 from .observations import Observation, ObservationSet
 from .observed import quiet_noise
-from .plausibility import Context
+from .plausibility import Context, implausible
 from .quality import GoodnessOfFit
 from .recording import Recording
 from .screening import reference_variances, require_constant_rate, screen_gaps
-from .segmentation import Segmentation, segment, standstill_level
+from .segmentation import Segmentation, given_windows, segment
 from .timebase import TimeBase
 from .turn_angle import follow_wander
 from .units import input_scale, parse_input_unit, parse_rate_unit, unit_factor
@@ -69,6 +69,9 @@ class CalibrationRun:
         What the self-checks found wrong or doubtful (fit quality, plausibility of k).
     notes : tuple of str
         What they found worth saying (the sensitivity counts imply).
+    implausible : str or None
+        Why the scale factors are not believable (:func:`gyrocal.plausibility.implausible`): the commands
+        refuse to write them unless told to accept them; None when plausible or the self-checks were off.
     """
 
     calibration: Calibration
@@ -81,6 +84,7 @@ class CalibrationRun:
     time_base: TimeBase | None = None
     warnings: tuple[str, ...] = ()
     notes: tuple[str, ...] = ()
+    implausible: str | None = None
 
     def parameters(self) -> list[tuple[str, float, float, str]]:
         """``(name, value, 1-sigma, unit)`` of k and b in user units (see :func:`parameter_rows`)."""
@@ -134,62 +138,6 @@ class CalibrationRun:
             lines.append(self.quality.summary())
         lines += [f"note: {n}" for n in self.notes] + [f"warning: {w}" for w in self.warnings]
         return "\n".join(lines)
-
-
-def _baseline(rec: Recording, windows: Sequence[Window]) -> np.ndarray:
-    return standstill_level(rec, windows)
-
-
-#: A given window's first or last tenth may turn this much slower than its middle (--speed only).
-_SPEED_SPREAD = 0.1
-
-
-def _require_constant_speed(samples: np.ndarray, w: Window, i: int) -> None:
-    """Refuse a window with ramps: the speed reference holds only on the constant-speed part."""
-    tenths = np.linalg.norm([part.mean(axis=0) for part in np.array_split(samples, min(10, len(samples)))], axis=1)
-    middle = float(np.median(tenths))
-    worst = float(min(tenths[0], tenths[-1]))
-    if worst < (1 - _SPEED_SPREAD) * middle:
-        raise InputError(
-            f"rotation window {i} ({w.label or f'{w.start}:{w.stop}'}) is not at constant speed: an end of it turns "
-            f"at {100 * worst / middle:.0f} % of its middle (a ramp); with a known speed the windows must cover only "
-            "the constant-speed part: trim them, or use the angle reference (--angle) with whole turns"
-        )
-
-
-def _given_windows(rec: Recording, windows: Sequence[Window], reference: str, speed, angle) -> Segmentation:
-    """A :class:`Segmentation` from user windows: axis and sense filled in, references attached."""
-    windows = list(windows)
-    if not windows:
-        raise InputError("windows is empty; give rotation and static windows, or None to detect them")
-    n, fs = len(rec), rec.sample_rate
-    for w in windows:
-        if not isinstance(w, Window):
-            raise InputError(f"windows must hold gyrocal.windows.Window objects, got {type(w).__name__}")
-        if w.stop > n:
-            raise InputError(f"window {w.label or ''} {w.start}:{w.stop} ends after the recording ({n} samples)")
-    base = _baseline(rec, windows)
-    out = []
-    for i, w in enumerate(windows):
-        if w.kind == "static":
-            out.append(dataclasses.replace(w, rate=0.0))
-            continue
-        if w.axis is None or w.sign == 0:
-            v = rec.gyro[w.start:w.stop].mean(axis=0) - base
-            j = int(np.abs(v).argmax())
-            w = dataclasses.replace(w, axis="xyz"[j], sign=1 if v[j] >= 0 else -1)
-        if reference == "speed":
-            _require_constant_speed(rec.gyro[w.start:w.stop] - base, w, i)
-            w = dataclasses.replace(w, angle=speed * len(w) / fs, rate=speed)
-        else:
-            a = w.angle if math.isfinite(w.angle) else angle
-            if a is None:
-                raise InputError(f"rotation window {i} ({w.label or f'{w.start}:{w.stop}'}) has no angle; give angle")
-            a = abs(float(a))
-            w = dataclasses.replace(w, angle=a, rate=a * fs / len(w))
-        out.append(w)
-    noise = np.full(3, np.nan)
-    return Segmentation(tuple(out), (), "file", fs, base, noise)
 
 
 def parameter_rows(cal: Calibration) -> list[tuple[str, float, float, str]]:
@@ -292,8 +240,8 @@ def calibrate(
     if windows is None:
         seg = segment(rec, reference=reference, speed=speed, angle=value, require=False)
     else:
-        seg = _given_windows(rec, windows, reference, value if reference == "speed" else None,
-                             value if reference == "angle" else None)
+        seg = given_windows(rec, windows, reference, value if reference == "speed" else None,
+                            value if reference == "angle" else None, screen=checks)
     tb = rec.time_base() if checks else None
     angle_var: dict = {}
     # the sensor's clock under receive-time stamps: without gaps its trapezoid weights are even (a window
@@ -318,7 +266,7 @@ def calibrate(
     if checks and uses_static and reference == "angle":  # a wandering axis: the integral is not the rotation
         observations, obs_set, fit = follow_wander(rec, rec.t if times is None else times, used, observations,
                                                    obs_set, fit, estimator)
-    quality, warnings, notes = None, [], []
+    quality, warnings, notes, refusal = None, [], [], None
     if checks:
         ctx = Context(units=input_units, counts_scale=rec.units == "counts", reference=reference,
                       declared=value if windows is None or reference == "speed" else math.nan,
@@ -327,7 +275,8 @@ def calibrate(
         scale = input_scale(input_units, rec.sensitivity, out_units)
         fit, obs_set, quality, warnings, notes = check_fit(fit, obs_set, estimator, [_label(w) for w in used],
                                                            reference=reference, ctx=ctx, input_scale=scale)
-        warnings[1 if quality.warnings else 0:0] = single_turn_warnings(
+        refusal = implausible(fit.model.k, ctx)
+        warnings[1 if quality.warnings else 0:0] = list(seg.warnings) + single_turn_warnings(
             [w.axis for w in used if w.kind == "rotation"], reference, None if windows and reference == "angle" else value)
         if reference_sd:
             what = ("every turn's angle, {:g} deg" if reference == "angle" else
@@ -349,7 +298,8 @@ def calibrate(
         # every warning and note printed goes in the file too: a flagged calibration must not look clean there
         cal = dataclasses.replace(cal, fit={**quality.to_document(), "warnings": list(warnings), "notes": list(notes)},
                                   observed=_observed(rec, tb, fit.noise_std, cal.input_scale, input_units))
-    return CalibrationRun(cal, fit, seg, observations, reference, value, quality, tb, tuple(warnings), tuple(notes))
+    return CalibrationRun(cal, fit, seg, observations, reference, value, quality, tb, tuple(warnings), tuple(notes),
+                          refusal)
 
 
 def _observed(rec: Recording, tb: TimeBase, noise_std, input_scale: float, input_units: str) -> dict:

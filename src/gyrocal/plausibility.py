@@ -17,7 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Context", "STANDARD_SENSITIVITIES", "check_plausibility", "nearest_setting"]
+__all__ = ["Context", "STANDARD_SENSITIVITIES", "check_plausibility", "far_scale", "implausible", "nearest_setting",
+           "still_units"]
 
 #: |k - 1| beyond this for physical units raises a warning: the MPU-9250's trim (+-3 %) with room for noise
 #: and temperature. At 10 % hand tilts of 48 deg declared 45 (k 6 % low) passed without a word.
@@ -26,6 +27,14 @@ K_TOLERANCE = 0.05
 COMMON_SPREAD = 0.05
 #: An implied sensitivity within this of a standard setting matches it (datasheet tolerance +-3 %).
 SETTING_TOLERANCE = 0.05
+
+#: The commands refuse (unless --accept-implausible) a k this far from 1 in physical units, or an implied
+#: sensitivity this far from every vendor's setting.
+K_REFUSE = 0.2
+#: Output data rates of common gyros [Hz]: a common factor that lands the declared rate on one names the cause.
+STANDARD_RATES = (10, 12.5, 20, 25, 50, 100, 104, 200, 208, 250, 400, 416, 500, 800, 833, 1000, 1600, 1666, 2000,
+                  3200, 3333, 4000, 6664, 8000)
+_DEG = 180 / math.pi
 
 #: Standard gyro sensitivities [LSB per deg/s] by full scale [+-deg/s], from the datasheets:
 #: InvenSense MPU-9250 (PS-MPU-9250A-01 rev 1.0, Table 1; the same for MPU-6050 and ICM-20602),
@@ -36,6 +45,8 @@ STANDARD_SENSITIVITIES: tuple[tuple[str, float, float], ...] = (
     ("ST", 125, 1000 / 4.375), ("ST", 250, 1000 / 8.75), ("ST", 500, 1000 / 17.5), ("ST", 1000, 1000 / 35.0),
     ("ST", 2000, 1000 / 70.0),
     ("Bosch", 125, 262.4), ("Bosch", 250, 131.2), ("Bosch", 500, 65.6), ("Bosch", 1000, 32.8), ("Bosch", 2000, 16.4),
+    # Analog Devices iSensor: ADIS16405 0.05 deg/s per LSB, ADIS16448 0.04, ADIS16470 0.1 (16-bit output)
+    ("ADI", 300, 20.0), ("ADI", 1000, 25.0), ("ADI", 2000, 10.0),
 )
 
 
@@ -159,3 +170,69 @@ def _counted_time(ctx: Context) -> str:
             "own oscillator runs off its nominal rate by a fraction of a per cent or more, far beyond k's 1-sigma, and "
             "a clock 0.5 % fast reads every k 0.5 % low. Stamp the samples with a PC's clock as they arrive (or measure "
             "the rate), or calibrate with a known speed (--speed), which does not depend on the time base")
+
+
+def _lsb(k: np.ndarray) -> tuple[float, str]:
+    lsb = math.pi / 180.0 / k  # k [rad/s per count] -> counts per deg/s
+    return float(np.exp(np.mean(np.log(lsb)))), ", ".join(f"{a} {v:.4g}" for a, v in zip("xyz", lsb))
+
+
+def _standard_rate(ctx: Context, c: float) -> bool:
+    """Whether the rate a common factor `c` implies is a standard one (the declared rate was wrong)."""
+    if ctx.reference != "angle" or (ctx.has_time and not ctx.counted):
+        return False
+    return any(abs(ctx.sample_rate / c / r - 1) < 0.005 for r in STANDARD_RATES)
+
+
+def implausible(k, ctx: Context) -> str | None:
+    """Why the commands refuse scale factors `k` (3,), or None: |k - 1| beyond :data:`K_REFUSE` for physical
+    units, a common factor that lands the declared rate on a standard one, or (counts alone) a sensitivity
+    farther than :data:`K_REFUSE` from every vendor's setting."""
+    k = np.abs(np.asarray(k, dtype=float))
+    if ctx.counts_scale:
+        mean, per_axis = _lsb(k)
+        off, rows = nearest_setting(mean)
+        if off <= K_REFUSE:
+            return None
+        return (f"the scale factors imply a sensitivity of {mean:.4g} LSB per deg/s ({per_axis}), {100 * off:.0f} % from "
+                f"the nearest vendor setting ({_settings_text(rows)}): no gyro is set so; check the declared angle or "
+                "speed and the sample rate, or give the sensitivity")
+    c = float(np.exp(np.mean(np.log(k))))
+    common = bool(np.all(np.abs(np.log(k / c)) <= math.log1p(COMMON_SPREAD)))
+    if common and abs(c - 1) > K_TOLERANCE and (abs(c - 1) > K_REFUSE or _standard_rate(ctx, c)):
+        return _common_cause(c, ctx, k)
+    unit = "counts with the declared sensitivity" if ctx.units == "counts" else ctx.units
+    return far_scale(k, unit, "the {} turns were not the declared " + ("angle" if ctx.reference == "angle" else "speed"))
+
+
+def far_scale(k, unit: str, cause: str) -> str | None:
+    """The diagnosis for scale factors `k` (3,) more than :data:`K_REFUSE` from 1 in physical `unit`, or None.
+    `cause` says what else may be wrong, ``{}`` standing for the axes."""
+    k = np.abs(np.asarray(k, dtype=float))
+    far = [(a, v) for a, v in zip("xyz", k) if abs(v - 1) > K_REFUSE]
+    if not far:
+        return None
+    ks = ", ".join(f"k{a} = {v:.4g}" for a, v in far)
+    c = float(np.exp(np.mean(np.log(k))))
+    hint = ""
+    if abs(math.log(c / _DEG)) < 0.05 or abs(math.log(c * _DEG)) < 0.05:
+        hint = f" (a common factor {c:.4g}: a deg/s against rad/s mix-up, check the units)"
+    return (f"{ks}: more than {100 * K_REFUSE:.0f} % from 1 for data in {unit}, which no MEMS gyro's trim comes near; "
+            f"{cause.format(', '.join(a for a, _ in far))}, or the unit is wrong{hint}")
+
+
+def still_units(bias, density, unit: str) -> str | None:
+    """The diagnosis for a still log whose bias [deg/s] or white-noise density [deg/s/sqrt(Hz)] (3,), read as
+    declared in `unit`, no MEMS gyro shows, or None: a zero-rate offset beyond 50 deg/s or a density beyond
+    0.5 (deg/s read as rad/s), or a density below 2e-4 on every axis (rad/s read as deg/s: the quietest MEMS
+    gyros, ADIS16495-class, reach 0.0015, and a chip's filter lowers the estimate by a few times at most)."""
+    bias, density = np.abs(np.asarray(bias, dtype=float)), np.asarray(density, dtype=float)
+    shown = (f"its bias reads {', '.join(f'{v:.3g}' for v in bias)} deg/s and its noise density "
+             f"{', '.join(f'{v:.3g}' for v in density)} deg/s/sqrt(Hz) as declared in {unit}")
+    if np.any(bias > 50) or np.any(density > 0.5):
+        return (f"a still MEMS gyro's zero-rate offset stays within about 20 deg/s and its noise density below 0.1 "
+                f"deg/s/sqrt(Hz), but {shown}: is the unit right (deg/s data declared rad/s read 57.3 times large)?")
+    if np.all((density > 0) & (density < 2e-4)):
+        return (f"no MEMS gyro is quieter than about 0.0015 deg/s/sqrt(Hz), but {shown}: is the unit right (rad/s "
+                "data declared deg/s read 57.3 times small)?")
+    return None

@@ -41,6 +41,7 @@ FLAGS: dict[str, str] = {
     "method": "--method",
     "noise_std": "--noise-std",
     "noise_density": "--noise-density",
+    "accept_implausible": "--accept-implausible",
     # imu
     "accel_model": "--accel-model",
     "gyro_model": "--gyro-model",

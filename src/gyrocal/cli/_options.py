@@ -10,7 +10,7 @@ import typer
 
 from ..errors import InputError
 
-__all__ = ["NoiseDensity", "StoreUrl", "given", "iso_time", "noise_std", "numbers", "refuse_unused", "triple"]
+__all__ = ["AcceptImplausible", "NoiseDensity", "StoreUrl", "given", "judge_plausible", "iso_time", "noise_std", "numbers", "refuse_unused", "triple"]
 
 
 def given(ctx: typer.Context, name: str) -> bool:
@@ -125,3 +125,30 @@ def iso_time(text: str | None, flag: str) -> datetime | None:
     except ValueError:
         raise InputError(f"{flag} takes an ISO 8601 time such as 2026-12-02T13:45:00Z, got {text!r}") from None
     return when.replace(tzinfo=timezone.utc) if when.tzinfo is None else when.astimezone(timezone.utc)
+
+
+AcceptImplausible = Annotated[bool, typer.Option(
+    "--accept-implausible", help="Write a result the plausibility rule refuses (a scale factor more than 20 % from 1 "
+    "for deg/s or rad/s, a common factor that points at the sample rate or the units, a sensitivity no vendor's "
+    "setting comes near), with the warning in the file (default: refuse, exit 2, nothing written).")]
+
+
+def judge_plausible(doc: dict, diagnosis: str | None, accept: bool) -> dict:
+    """The result document `doc`, refused (one line, exit 2, before anything is written) when `diagnosis` says it
+    is implausible, unless `accept`: then with the diagnosis among its warnings (the file's own, the fit's, or the
+    settings' for a thermal table without a fit section)."""
+    if diagnosis is None:
+        return doc
+    if not accept:
+        raise InputError(f"implausible result, nothing written: {diagnosis}", param="accept_implausible",
+                         hint="if every declaration is right, give {param} to write it with this warning in the file")
+    from .app import warn
+
+    text = f"written with --accept-implausible: {diagnosis}"
+    warn(text)
+    fit = doc.get("fit")
+    if isinstance(doc.get("warnings"), list):  # the file's own warnings (thermal-bias)
+        return {**doc, "warnings": doc["warnings"] + [text]}
+    if isinstance(fit, dict):  # a calibration's fit section
+        return {**doc, "fit": {**fit, "warnings": list(fit.get("warnings") or []) + [text]}}
+    return {**doc, "settings": {**(doc.get("settings") or {}), "warnings": [text]}}

@@ -18,6 +18,7 @@ import typer
 
 from ..choices import Method
 from ..errors import GyrocalError, InputError
+from ._options import AcceptImplausible, judge_plausible
 from ._outputs import check_output, same_document
 from ._reading import READING, read_from_flags, required_units
 from ._references import density_to_internal, noise_to_internal, rate_unit_of, reference_of
@@ -194,6 +195,7 @@ def calibrate(
     output: Output = None,
     plot: PlotPath = None,
     force: Force = False,
+    accept_implausible: AcceptImplausible = False,
     example: Annotated[bool, typer.Option(
         "--example", help="Run on the bundled simulated MPU9250 servo recording (deg/s, --speed 60 unless "
         "--angle or --windows).")] = False,
@@ -232,7 +234,7 @@ def calibrate(
                           output_units=rate_unit, reference_sd=ref_sd)
     cal = _with_notes(run.calibration, read_notes)
     inputs = (Path(recording), windows)
-    doc, verdict = finish(cal.to_document(), flags, inputs=inputs)
+    doc, verdict = finish(judge_plausible(cal.to_document(), run.implausible, accept_implausible), flags, inputs=inputs)
     check_output(output, inputs=inputs, force=force, replaceable=same_document(doc),
                  holds="a different calibration or another file")
     check_output(plot, flag="--plot", inputs=inputs + (output,), outputs=(output,), force=True)
@@ -299,10 +301,14 @@ def segments(
                           no_unit_check=no_unit_check, imu=imu)
     given = _windows_from_file(windows, rec)
     ignored: list = []
+    seg = None
     if given is not None:
-        from ..segmentation import standstill_level
+        from ..segmentation import given_windows, standstill_level
 
         found, source, baseline = given, f"from {windows}", standstill_level(rec, given)
+        if reference == "angle":  # each turn's declared angle beside its measured one; the contradicted ones left out
+            seg = given_windows(rec, given, "angle", None, angle_rad or 2 * math.pi)
+            found, ignored = list(seg.windows), list(seg.ignored)
     else:
         from ..segmentation import segment
 
@@ -321,12 +327,15 @@ def segments(
         console.print(line, highlight=False, markup=False, soft_wrap=True)
     angle_unit = "counts s" if rec.units == "counts" else "deg"
     table = Table()
-    for col in ("#", "kind", "turn", "start", "stop", "t0 [s]", "length [s]", f"angle [{angle_unit}]",
-                f"mean rate [{disp}]"):
+    shown = given is not None and reference == "angle"  # a windows file's declared angles, beside the measured
+    for col in ("#", "kind", "turn", "start", "stop", "t0 [s]", "length [s]") + (("declared [deg]",) if shown else ()) + (
+            f"angle [{angle_unit}]", f"mean rate [{disp}]"):
         table.add_column(escape(col), justify="right" if col not in ("kind", "turn") else "left", no_wrap=True)
-    for i, w in enumerate(found):
+    for w in found:
+        i = next(j for j, g in enumerate(given) if g.start == w.start) if given is not None else found.index(w)
         table.add_row(str(i), w.kind, _turn(w), str(w.start), str(w.stop), f"{rec.t[w.start]:.2f}",
-                      f"{times[w.stop - 1] - times[w.start]:.2f}", *_measured(rec, w, baseline, times, disp))
+                      f"{times[w.stop - 1] - times[w.start]:.2f}", *((_declared(w),) if shown else ()),
+                      *_measured(rec, w, baseline, times, disp))
     console.print(table)
     if ignored:
         console.print(f"{len(ignored)} ignored:")
@@ -339,17 +348,22 @@ def segments(
         console.print(skipped)
     else:
         console.print("nothing ignored")
-    if given is None:
-        try:
-            seg.require()
-        except GyrocalError as exc:
-            warn(message(exc))
+    try:
+        seg is None or seg.require()
+    except GyrocalError as exc:
+        warn(message(exc))
+    for line in () if seg is None else seg.warnings:
+        warn(line)
     if plot is not None:
         from ..plotting import save_figure
         from ..plotting.calibration import calibration_figure
 
         save_figure(calibration_figure(rec, found, title=f"{recording.name}: windows {source}", ignored=ignored), plot)
         console.print(f"wrote {plot}", highlight=False)
+
+
+def _declared(w) -> str:
+    return "" if w.kind == "static" else f"{math.degrees(w.angle):g}"
 
 
 def _turn(w) -> str:

@@ -9,6 +9,7 @@ from typing import Annotated, Optional
 
 import typer
 
+from ._options import AcceptImplausible, judge_plausible
 from ._outputs import check_output, json_format
 from ._reading import READING, read_from_flags, required_units
 from ._station import StationFlags, conclude, finish, station_flags, write_and_store
@@ -56,6 +57,19 @@ def _summary(tb, unit: str, factor: float, title: str | None = None):
     return table
 
 
+def _implausible(tb, rec, log: Path, fs: float) -> str | None:
+    """The plausibility rule on a still log whose unit was declared (a flight log's unit is its format's)."""
+    import numpy as np
+
+    from ..io.flightlog import flight_log_kind
+    from ..plausibility import still_units
+
+    if log.is_file() and flight_log_kind(log) is not None or rec.source_units not in ("deg/s", "rad/s"):
+        return None
+    deg = 180 / math.pi
+    return still_units(tb.bias_at([tb.tref])[0] * deg, np.asarray(tb.noise_std) * deg / math.sqrt(fs), rec.source_units)
+
+
 @app.command("thermal-bias")
 @station_flags
 def thermal_bias(
@@ -80,6 +94,7 @@ def thermal_bias(
     gravity: READING.Gravity = 9.80665,
     force: Annotated[bool, typer.Option("--force", help="Replace an -o file that is not a thermal-bias file.")]
     = False,
+    accept_implausible: AcceptImplausible = False,
     flags: StationFlags = StationFlags(),
 ) -> None:
     """Fit gyro bias (and accelerometer offset change) against temperature for PX4 and ArduPilot (export with
@@ -100,7 +115,8 @@ def thermal_bias(
         source["accel_units"] = rec.accel_source_units
     tb = fit_thermal_bias(rec.gyro, rec.temp, fs, max_order=max_order, min_span=min_span, source=source,
                           accel=rec.accel)
-    doc, verdict = finish(tb.to_document(), flags, inputs=(log,), device_id=source.get("device_id"))
+    doc = judge_plausible(tb.to_document(), _implausible(tb, rec, log, fs), accept_implausible)
+    doc, verdict = finish(doc, flags, inputs=(log,), device_id=source.get("device_id"))
     record = write_and_store(doc, flags, output, verdict, inputs=(log,), kind="thermal-bias", job="thermal-bias")
     _print(tb, rec, output_units, gravity, fs)
     if output is not None:

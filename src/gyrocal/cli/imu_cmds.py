@@ -9,6 +9,7 @@ import typer
 
 from ..choices import AccelModel, AccelOutputUnit, ImuGyroModel
 from ._imu_report import print_imu_run
+from ._options import AcceptImplausible, judge_plausible
 from ._outputs import check_output, same_document
 from ._reading import READING, read_from_flags, required_units
 from ._station import StationFlags, conclude, finish, station_flags, write_and_store
@@ -61,11 +62,12 @@ def imu(
         "(default: none).")] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace an output that holds another calibration.")]
     = False,
+    accept_implausible: AcceptImplausible = False,
     flags: StationFlags = StationFlags(),
 ) -> None:
     """Calibrate gyro and accelerometer together from still poses and hand turns (no turntable needed)."""
     from ..errors import InputError
-    from ..imu.run import calibrate_recording
+    from ..imu.run import calibrate_recording, implausible
 
     units = required_units(units)
     if accel_units is None:
@@ -95,7 +97,8 @@ def imu(
                               g_sensitivity=g_sensitivity, min_static=min_static, output_units=output_units,
                               accel_output_units=accel_output_units)
     inputs = (recording, windows, accel_log)
-    doc, verdict = finish(run.calibration.to_document(), flags, inputs=inputs)
+    doc = judge_plausible(run.calibration.to_document(), implausible(run.calibration), accept_implausible)
+    doc, verdict = finish(doc, flags, inputs=inputs)
     check_output(output, inputs=inputs, force=force, replaceable=same_document(doc),
                  holds="a different calibration or another file")
     if plot is not None:

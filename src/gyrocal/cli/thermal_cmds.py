@@ -13,6 +13,7 @@ import typer
 
 from ..choices import OutOfRange
 from ..errors import InputError
+from ._options import AcceptImplausible, judge_plausible
 from ._outputs import check_output, refuse_swapped, same_document
 from ._reading import READING
 from ._station import StationFlags, conclude, finish, station_flags, write_and_store
@@ -83,6 +84,7 @@ def thermal(
         "--temp-tau", help="Time constant for smoothing per-sample temperature when compensating (s).")] = 20.0,
     force: Annotated[bool, typer.Option("--force", help="Replace an -o file that holds a different calibration.")]
     = False,
+    accept_implausible: AcceptImplausible = False,
     flags: StationFlags = StationFlags(),
 ) -> None:
     """Fit a temperature table (the full-temperature-range method) from a turntable session."""
@@ -97,13 +99,26 @@ def thermal(
                                      temp_tolerance=temp_tolerance, reference_temp=ref_temp, max_order=max_order,
                                      temp_tau=temp_tau, names=names)
     inputs = [session / name for name in names] if session.is_dir() else [session]  # a folder: each file read
-    doc, verdict = finish(cal.to_document(), flags, inputs=inputs)
+    doc = judge_plausible(cal.to_document(), _implausible(cal), accept_implausible)
+    doc, verdict = finish(doc, flags, inputs=inputs)
     check_output(output, inputs=(session,), force=force, replaceable=same_document(doc),
                  holds="a different calibration or another file")
     record = write_and_store(doc, flags, output, verdict, inputs=inputs, kind="thermal", job="thermal")
     _print_table(cal, fit)
     console.print(f"wrote {output}")
     conclude(console, doc, flags, record, verdict)
+
+
+def _implausible(cal) -> str | None:
+    """The plausibility rule on the table's scale factors (1 / Kxx.. at the temperature where they are worst)."""
+    import numpy as np
+
+    from ..plausibility import far_scale
+
+    k = 1.0 / np.abs(cal.kg[:, :3])  # K maps the table's rate to the reading; the scale factor is its inverse
+    worst = int(np.argmax(np.max(np.abs(np.log(k)), axis=1)))
+    text = far_scale(k[worst], cal.input_units, "the table_rate column is not the table's rate about {}")
+    return None if text is None else f"at {cal.temps[worst]:.1f} degC, {text}"
 
 
 def _print_table(cal, fit) -> None:

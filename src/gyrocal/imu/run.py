@@ -25,7 +25,7 @@ from ..units import STANDARD_GRAVITY, parse_rate_unit
 from .filedoc import accelerometer_section, gyro_fit_section
 from .session import ImuCalibrationResult, calibrate_imu
 
-__all__ = ["ImuRun", "accel_scale", "calibrate_recording", "plausibility"]
+__all__ = ["ImuRun", "accel_scale", "calibrate_recording", "implausible", "plausibility"]
 
 ACCEL_OUTPUT_UNITS = ("m/s^2", "g")
 #: A gap of at most this many lost samples is integrated across (its trapezoid error is third order in
@@ -76,6 +76,20 @@ def plausibility(cal: Calibration) -> tuple[str, ...]:
             out.append(f"the accelerometer's scale factors are {', '.join(f'{v:.4g}' for v in k)}, far from 1: is "
                        f"--accel-units {units['input']} right?{_unit_hint(k, STANDARD_GRAVITY, 'g', 'm/s^2')}")
     return tuple(out)
+
+
+def implausible(cal: Calibration) -> str | None:
+    """Why the commands refuse this calibration (None: plausible): the scale factors of :func:`plausibility`
+    (more than 20 % from 1 in physical units), or gyro counts whose sensitivity no vendor's setting comes near."""
+    out = list(plausibility(cal))
+    if cal.input_units == "counts" and cal.sensitivity is None:
+        from ..plausibility import Context
+        from ..plausibility import implausible as judge
+
+        ctx = Context(units="counts", counts_scale=True, reference="angle", declared=float("nan"), sample_rate=1.0,
+                      has_time=True)
+        out.append(judge(np.diag(np.asarray(cal.model.matrix, dtype=float)), ctx))
+    return "; ".join(t for t in out if t) or None
 
 
 def _unit_hint(k: np.ndarray, factor: float, big: str, small: str) -> str:

@@ -62,6 +62,8 @@ class Segmentation:
         Internal units of the readings (to show the turns measured).
     advice : str
         The most likely fix when the turns a method needs are missing (see :meth:`require`).
+    warnings : tuple of str
+        What a person should check in the windows given (turns that disagree with none to blame).
     """
 
     windows: tuple[Window, ...]
@@ -72,6 +74,7 @@ class Segmentation:
     noise_std: np.ndarray = field(default_factory=lambda: np.full(3, np.nan))
     units: str = "rad/s"
     advice: str = ""
+    warnings: tuple[str, ...] = ()
 
     def __post_init__(self):
         object.__setattr__(self, "windows", tuple(sorted(self.windows, key=lambda w: w.start)))
