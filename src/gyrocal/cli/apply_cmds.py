@@ -48,12 +48,12 @@ def apply(
         "'gyrocal apply' already corrected.")] = False,
     store: Annotated[Optional[str], typer.Option(
         "--store", help="Take the calibration from this store: the unit's (--unit) in force at the recording's "
-        "time (its file's modification time, or --at); give only the recording.", metavar="URL",
+        "time (its file's modification time, or --at); give only the recording (default: none).", metavar="URL",
         rich_help_panel="Production station")] = None,
-    unit_serial: Annotated[Optional[str], typer.Option("--unit", help="With --store: the unit's serial.",
+    unit_serial: Annotated[Optional[str], typer.Option("--unit", help="With --store: the unit's serial (default: none).",
                                                        metavar="SERIAL", rich_help_panel="Production station")] = None,
     at: Annotated[Optional[str], typer.Option("--at", help="With --store: the time (ISO 8601) instead of the "
-                                              "recording's.", rich_help_panel="Production station")] = None,
+                                              "recording's (default: its file time).", rich_help_panel="Production station")] = None,
 ) -> None:
     """Correct a recording; gyro columns are replaced by corrected rates, other columns pass through."""
     # long function: the command's steps in order (calibration, reading, checks, correction, output)

@@ -56,12 +56,12 @@ def _finite(x):
 def fleet(
     store: StoreUrl,
     output: Annotated[Optional[Path], typer.Option(
-        "-o", "--output", help="Report folder: fleet.md and a histogram and control chart (PNG) per parameter.")] = None,
+        "-o", "--output", help="Report folder: fleet.md and a histogram and control chart (PNG) per parameter (default: none, --json only).")] = None,
     limits: Annotated[Optional[Path], typer.Option(
         "--limits", help="Specification limits (TOML; default: the records' own acceptance sections).",
         metavar="FILE")] = None,
     since: Annotated[Optional[str], typer.Option("--since", help="Only records created at or after this ISO 8601 "
-                                                 "time.")] = None,
+                                                 "time (default: all).")] = None,
     kind: Annotated[Optional[str], typer.Option("--kind", help="Only calibrations of this kind or family "
                                                 "(calibration, calibration.servo, imu; default: all).")] = None,
     confidence: Annotated[float, typer.Option("--confidence", help="Level of the intervals.")] = 0.95,

@@ -88,7 +88,7 @@ def thermal_bias(
         "--min-span", help="Smallest temperature span accepted [degC] (ArduPilot's minimum: 10).")] = 10.0,
     accel_units: Annotated[Optional[str], typer.Option(
         "--accel-units", help="Also fit the accelerometer's offset change from the reference temperature: unit of "
-        "its columns, m/s^2 or g (counts with --accel-sensitivity; flight logs: m/s^2).",
+        "its columns, m/s^2 or g (counts with --accel-sensitivity; flight logs: m/s^2) (default: gyro only).",
         metavar="<m/s^2|g|counts>")] = None,
     accel_sensitivity: READING.AccelSensitivity = None,
     gravity: READING.Gravity = 9.80665,
