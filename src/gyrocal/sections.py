@@ -201,13 +201,15 @@ class FitQuality(Section):
     ``disagree`` (the windows that disagree most, when flagged), ``warnings`` (list of text),
     ``excess`` (the scatter beyond the noise the covariance carries: ``turn_reference_sd`` in
     ``turn_reference_unit``, ``static_level_sd`` per axis in ``static_level_unit``, and ``groups``, each
-    group's noise-only ``chi2`` for its ``dof``; null for the paper's methods) and ``notes`` (list of text).
+    group's noise-only ``chi2`` for its ``dof``; null for the paper's methods), ``notes`` (list of text) and
+    ``sigma_covers`` (``{"k": text, "b": text}``: what each 1-sigma holds; older files lack it).
     """
 
     NAME = "fit"
     FIELDS = {"chi2": number(0), "dof": integer(0), "chi2_per_dof": number(0), "p_value": number(0, 1),
               "birge_ratio": number(0), "covariance_scaled": boolean, "residuals": _residuals,
-              "labels": texts, "disagree": numbers((-1,), 0), "warnings": texts, "notes": texts}
+              "labels": texts, "disagree": numbers((-1,), 0), "warnings": texts, "notes": texts,
+              "sigma_covers": obj}
 
 
 class Observed(Section):

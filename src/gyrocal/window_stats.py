@@ -14,7 +14,8 @@
   (angle reference) integrates the same sensor noise, so its mean takes that long-run variance
   too: a chip's internal low-pass filter makes successive samples alike, and the white noise of
   first differences then understates a turn's angle noise (twenty times at 1 kHz behind a 41 Hz
-  filter). The plateaus' residuals hold the sensor noise and the servo's bounded angle error
+  filter). Without static windows the turns' non-rotating axes give that long-run variance
+  (:func:`_turns_lrv`). The plateaus' residuals hold the sensor noise and the servo's bounded angle error
   (vibration), which :func:`gyrocal.longrun.span_variance` separates.
 
 The plateau and static statistics work on block means at about 200 Hz: the same level, the
@@ -103,13 +104,46 @@ def _window_stats(rec: Recording, windows: Sequence[Window], reference: str, tim
     out: dict[int, dict] = {}
     if plateaus:
         out = _plateau_stats(blocks, span, plateaus, times, d, long_run=long_run, ripple=ripple)
+    lrv = None
     if long_run and statics:
         lrv = _pooled_lrv([lambda b=blocks[i]: b - b.mean(axis=0) for i in statics], [len(blocks[i]) for i in statics])
         for i in statics:
             out[i] = {"mean_var": lrv / len(blocks[i])}
+    elif long_run and turns:  # no standstill: the turns' own quiet axes hold the same sensor noise
+        lrv = _turns_lrv([blocks[i] for i in turns if i in blocks])
+    if lrv is not None:
         for i in turns:  # the turn's mean integrates the same sensor noise over its length
             out[i] = {"mean_var": lrv * d / len(windows[i])}
     return out
+
+
+#: An axis is quiet in a turn when its reading follows the turning axis's by at most this factor (a
+#: misaligned mount, cross-axis sensitivity); a turn about a diagonal has no quiet axis.
+_QUIET_SLOPE = 0.2
+
+
+def _turns_lrv(turns: list[np.ndarray]) -> np.ndarray | None:
+    """Long-run variance per block-mean sample (3,) from the turns' non-rotating axes, or None.
+
+    In a turn about one sensor axis the other two read the bias, the turning rate through the mount's
+    misalignment, and the sensor's noise: regressed on the turning axis's reading, what is left is the
+    noise (a chip's filter and the bias's wander within the turn included). Each axis pools its residuals
+    from the turns where it is quiet; an axis quiet in none borrows the mean of the others.
+    """
+    pooled: list[list[np.ndarray]] = [[], [], []]
+    for g in turns:
+        j = int(np.argmax(np.abs(g.mean(axis=0))))
+        X = np.column_stack([np.ones(len(g)), g[:, j] - g[:, j].mean()])
+        coef, *_ = np.linalg.lstsq(X, g, rcond=None)
+        resid = g - X @ coef
+        for a in range(3):
+            if a != j and abs(coef[1, a]) <= _QUIET_SLOPE:
+                pooled[a].append(resid[:, a])
+    lrv = np.array([newey_west_var(np.concatenate(r)[:, None])[0] * sum(map(len, r)) if r else np.nan
+                    for r in pooled])
+    if np.isnan(lrv).all():
+        return None
+    return np.where(np.isnan(lrv), np.nanmean(lrv), lrv)
 
 
 def _plateau_stats(blocks: dict, span: dict, plateaus: list[int], times: np.ndarray | None, d: int, *,
