@@ -36,6 +36,8 @@ __all__ = ["Static", "StaticDetection", "detect_statics", "long_run_ratio", "sum
 _QUIET_PERCENTILE = 5.0
 _QUIET_FACTOR = 3.0
 _FALSE_MOTION = 1e-4
+#: Smallest long-run over per-sample variance ratio taken (tremor's zero-mean swings average out in a pose).
+LRV_FLOOR = 0.1
 
 
 @dataclass(frozen=True)
@@ -180,7 +182,7 @@ def long_run_ratio(x: np.ndarray, segments, lags: int) -> np.ndarray:
 
     Bartlett-weighted autocovariances (Newey and West) up to `lags`, summed over the still
     segments after removing each segment's mean; 1 for white noise, more for low-pass filtered
-    noise. The standard error of a segment mean is ``std * sqrt(ratio / n)``.
+    noise, less (down to :data:`LRV_FLOOR`) for oscillations such as a hand's tremor. The standard error of a segment mean is ``std * sqrt(ratio / n)``.
     """
     g = np.zeros((lags + 1, 3))
     for a, b in segments:
@@ -191,7 +193,8 @@ def long_run_ratio(x: np.ndarray, segments, lags: int) -> np.ndarray:
         return np.ones(3)
     w = 1.0 - np.arange(lags + 1) / (lags + 1.0)
     lrv = g[0] + 2.0 * (w[1:, None] * g[1:]).sum(axis=0)
-    return np.clip(lrv / g[0], 1.0, None)
+    # below 1 where the noise averages out faster than white noise (a hand's tremor, a periodic ripple)
+    return np.clip(lrv / g[0], LRV_FLOOR, None)
 
 
 def summarise_statics(t, gyro, accel, spans, labels=None, *, lags: int | None = None) -> tuple[Static, ...]:
