@@ -107,7 +107,10 @@ def _broken_files(d: Path) -> None:
     table("notime.csv", arr[:, 1:], head="gx,gy,gz")
     a = arr.copy()
     a[100:, 0] -= 1.0
-    table("backwards.csv", a)
+    table("backwards.csv", a)  # a second part glued on: a break, not an error
+    a = arr.copy()
+    a[100, 0] = a[99, 0] - 0.002
+    table("jitterback.csv", a)  # one stamp back by less than a period: refused
     a = arr.copy()
     a[:, 0] *= 1000
     table("ms.csv", a)
@@ -176,7 +179,8 @@ CASES = [
     ("calibrate {headerless.csv} --units deg/s", 2, r"--columns t=1,gx=2,gy=3,gz=4"),
     ("calibrate {headerless.csv} --units deg/s --columns t=1,gx=2,gy=3,gz=4 --speed 60", 0, ""),
     ("calibrate {zeros.csv} --units deg/s", 2, "every reading is the same"),
-    ("calibrate {backwards.csv} --units deg/s", 2, "time going backwards"),
+    ("calibrate {backwards.csv} --units deg/s --speed 60", 0, ""),
+    ("calibrate {jitterback.csv} --units deg/s", 2, "time going backwards"),
     ("calibrate {ms.csv} --units deg/s --speed 60", 2, "time_ms"),
     ("calibrate {semicolon.csv} --units deg/s --speed 60", 0, ""),
     ("calibrate {meta.csv} --units deg/s --speed 60", 0, ""),

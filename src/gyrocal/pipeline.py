@@ -32,7 +32,7 @@ from .observed import quiet_noise
 from .plausibility import Context, implausible
 from .quality import GoodnessOfFit
 from .recording import Recording
-from .screening import reference_variances, require_constant_rate, screen_gaps
+from .screening import reference_variances, require_constant_rate, screen_breaks, screen_gaps
 from .segmentation import Segmentation, given_windows, segment
 from .timebase import TimeBase
 from .turn_angle import follow_wander
@@ -249,6 +249,7 @@ def calibrate(
     # lasts count x period), so only a clock with gaps needs its sample times rebuilt
     period = tb.clock_period if tb is not None and tb.regular_clock and not tb.gaps else None
     times = tb.clock_times() if tb is not None and tb.gaps else None
+    seg = screen_breaks(seg, rec.breaks if tb is None else tb.breaks)
     if tb is not None:
         seg, angle_var = screen_gaps(seg, rec, tb, reference, times)
     uses_static = method == "first-moment"

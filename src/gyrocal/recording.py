@@ -76,6 +76,9 @@ class Recording:
         Unit the accelerometer data were declared in, for output.
     accel_sensitivity : float or None
         LSB per g, when raw accelerometer counts were converted to m/s^2.
+    breaks : tuple of int
+        Samples that start a new part of a log that is not contiguous (:mod:`gyrocal.breaks`):
+        no window, pose or turn spans one.
     """
 
     t: np.ndarray
@@ -93,6 +96,7 @@ class Recording:
     accel_units: Literal["m/s^2", "counts"] | None = None
     accel_source_units: str | None = None
     accel_sensitivity: float | None = None
+    breaks: tuple[int, ...] = ()
 
     def __post_init__(self):
         gyro = finite_array("gyro", self.gyro, shape_tail=(3,), ndim=2)
@@ -123,6 +127,10 @@ class Recording:
                 raise InputError("axis must hold one of 'x', 'y', 'z' for every sample")
             object.__setattr__(self, "axis", readonly(axis, None, copy=False))
         self._check_accel(n)
+        breaks = tuple(sorted({int(b) for b in self.breaks}))
+        if breaks and not 0 < breaks[0] <= breaks[-1] < n:
+            raise InputError(f"breaks must lie between samples 1 and {n - 1}, got {breaks[0]}..{breaks[-1]}")
+        object.__setattr__(self, "breaks", breaks)
 
     def _check_accel(self, n: int) -> None:
         if self.accel is None:
@@ -158,7 +166,7 @@ class Recording:
 
     def time_base(self) -> TimeBase:
         """Facts about the time stamps: nominal rate, jitter, late deliveries and real gaps."""
-        return analyse_time(self.t, has_time=self.has_time)
+        return analyse_time(self.t, has_time=self.has_time, breaks=self.breaks)
 
     def slice(self, start: int, stop: int) -> np.ndarray:
         """Readings of samples ``start:stop`` (N, 3)."""

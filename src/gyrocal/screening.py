@@ -5,6 +5,8 @@
   hide is bounded by the rates on either side; a turn keeps that bound as the uncertainty of its
   angle when it is small (at most 1 % of the turn), and is left out otherwise, with the gap in
   the reason. Plateau means (speed reference) and static means lose nothing but samples.
+* A break (the log is not contiguous, see :mod:`gyrocal.breaks`) inside a turn joins two
+  unrelated motions: the turn is left out. A static window across one is cut there into its parts.
 * Algorithm 1 and LM (the servo method of Wang et al., eq. 4-8) average ``m^2`` and assume a
   constant speed in every window; a window whose rate varies (ramps, a hand turn) reads k low by
   about half its squared coefficient of variation. They refuse such windows and point to the
@@ -19,6 +21,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from .breaks import spans_break, split_spans
 from .errors import InputError
 from .recording import Recording
 from .segmentation import Segmentation
@@ -26,7 +29,10 @@ from .timebase import Gap, TimeBase
 from .windows import Window
 
 __all__ = ["MAX_GAP_SHARE", "MAX_RATE_CV", "rate_variation", "reference_variances", "require_constant_rate",
-           "screen_gaps"]
+           "screen_breaks", "screen_gaps"]
+
+#: Shortest part of a static window cut at a break that is kept [samples].
+MIN_STATIC_PART = 10
 
 #: Largest rate variation (sd / mean, noise removed) the paper's methods accept: k low by about 0.5 %.
 MAX_RATE_CV = 0.10
@@ -62,6 +68,24 @@ def _gap_bound(rec: Recording, t: np.ndarray, w: Window, gap: Gap, baseline: np.
     spread = abs(float(ra.mean()) - float(rb.mean())) / 2 + 3 * noise * math.sqrt(1 / len(ra) + 1 / len(rb))
     dt = np.diff(t[w.start:w.stop])[:, None]
     return length * spread, float(np.linalg.norm(np.sum((seg[1:] + seg[:-1]) / 2 * dt, axis=0)))
+
+
+def screen_breaks(seg: Segmentation, breaks) -> Segmentation:
+    """Windows across a break: turns left out (with the reason), static windows cut into their parts."""
+    if not breaks or not any(spans_break(w.start, w.stop, breaks) for w in seg.windows):
+        return seg
+    kept, dropped = [], []
+    for w in seg.windows:
+        if not spans_break(w.start, w.stop, breaks):
+            kept.append(w)
+        elif w.kind == "rotation":
+            at = next(b for b in breaks if w.start < b < w.stop)
+            dropped.append((w, f"break: the log is not contiguous inside the turn (before sample {at}); "
+                               "its angle joins two unrelated motions"))
+        else:
+            kept += [dataclasses.replace(w, start=a, stop=b) for a, b in split_spans(w.start, w.stop, breaks)
+                     if b - a >= MIN_STATIC_PART]
+    return dataclasses.replace(seg, windows=tuple(kept), ignored=seg.ignored + tuple(dropped))
 
 
 def screen_gaps(seg: Segmentation, rec: Recording, tb: TimeBase, reference: str, times: np.ndarray | None = None,

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .breaks import BREAK_PERIODS, BREAK_S, describe_breaks
 from .errors import InputError
 from .timegaps import LATE_STEP as _LATE_STEP
 from .timegaps import Gap, find_gaps
@@ -84,6 +85,9 @@ class TimeBase:
         :meth:`clock_times` rebuilds the sample times on that clock.
     clock_start, clock_period : float
         The regular clock ``t = clock_start + clock_period x (sample number, gaps counted)`` [s].
+    breaks : tuple of int
+        Samples that start a new part of a log that is not contiguous (:mod:`gyrocal.breaks`): the
+        recording's own (a counter, time stepping back) and time steps forward far beyond the clock.
     """
 
     n: int
@@ -98,6 +102,7 @@ class TimeBase:
     regular_clock: bool = False
     clock_start: float = 0.0
     clock_period: float = 0.0
+    breaks: tuple[int, ...] = ()
 
     @property
     def sample_rate(self) -> float:
@@ -158,13 +163,15 @@ class TimeBase:
         """JSON-ready facts (the calibration file's ``observed.time_base``), times in seconds."""
         return {"nominal_rate": self.sample_rate, "has_time": self.has_time, "mean_step": self.mean_step,
                 "median_step": self.median_step, "jitter": self.jitter, "late_deliveries": self.delayed,
-                "gaps": len(self.gaps), "lost_samples": self.lost, "regular_clock": self.regular_clock}
+                "gaps": len(self.gaps), "lost_samples": self.lost, "regular_clock": self.regular_clock,
+                "breaks": list(self.breaks)}
 
     def describe(self) -> list[str]:
         """Plain lines for people: rate, steps, jitter, delayed deliveries and gaps."""
         ms = 1e3
         if not self.has_time:
-            return [f"time base: no time column; {self.sample_rate:.6g} Hz as declared, {self.n} samples"]
+            return [f"time base: no time column; {self.sample_rate:.6g} Hz as declared, {self.n} samples",
+                    *self._break_lines()]
         jitter = f"{self.jitter * ms:.3g} ms" if self.jitter > 1e-6 * self.period else "none"
         lines = [
             f"time base: {self.sample_rate:.6g} Hz nominal (mean step of the sensor clock); "
@@ -183,7 +190,12 @@ class TimeBase:
             lines.append(f"  {len(self.gaps)} gap(s), {self.lost} sample(s) missing; longest {worst.step * ms:.4g} ms "
                          f"at sample {worst.index} ({worst.lost} lost): a turn across a gap keeps it as a bound on its angle, "
                          "or is left out when that bound exceeds 1 %")
-        return lines
+        return lines + self._break_lines()
+
+    def _break_lines(self) -> list[str]:
+        if not self.breaks:
+            return []
+        return ["  " + describe_breaks(self.breaks, self.clock_start + self.period * np.asarray(self.breaks))]
 
 
 def _block_size(period: float, n: int) -> int:
@@ -241,7 +253,7 @@ def _count_steps_over(t: np.ndarray, limit: float) -> int:
     return sum(int(np.count_nonzero(step > limit)) for step in _steps(t))
 
 
-def analyse_time(t, *, has_time: bool = True) -> TimeBase:
+def analyse_time(t, *, has_time: bool = True, breaks=()) -> TimeBase:
     """Read the time base of stamps `t` [s] (strictly increasing).
 
     Parameters
@@ -251,6 +263,9 @@ def analyse_time(t, *, has_time: bool = True) -> TimeBase:
     has_time : bool
         Whether the stamps came from the data; a time base built from a declared rate is
         regular but may still hold gaps (rows dropped for saturation).
+    breaks : sequence of int
+        Known breaks (:attr:`gyrocal.recording.Recording.breaks`); steps forward longer than
+        :data:`gyrocal.breaks.BREAK_S` and :data:`gyrocal.breaks.BREAK_PERIODS` periods are added.
     """
     # long function: the facts in the order they depend on each other, each pass a stretch at a time
     t = np.asarray(t, dtype=float)
@@ -291,7 +306,15 @@ def analyse_time(t, *, has_time: bool = True) -> TimeBase:
         regular_clock=clock is not None,
         clock_start=clock[0] if clock else float(t[0]),
         clock_period=clock[1] if clock else period,
+        breaks=_breaks(t, longest, period, breaks),
     )
+
+
+def _breaks(t: np.ndarray, longest: float, period: float, given) -> tuple[int, ...]:
+    """The given breaks and the steps forward far beyond the clock."""
+    limit = max(BREAK_S, BREAK_PERIODS * period)
+    jumps = np.flatnonzero(np.diff(t) > limit) + 1 if longest > limit else ()
+    return tuple(sorted({int(b) for b in given} | {int(b) for b in jumps}))
 
 
 def _late(t: np.ndarray, longest: float, sample: np.ndarray, period: float, gaps) -> int:

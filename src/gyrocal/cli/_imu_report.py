@@ -110,11 +110,24 @@ def _print_pairs(g) -> None:
     worst = max(pairs, key=lambda c: c.chi2)
     misfit = np.array([c.residual_deg for c in pairs])
     bad = [c.label for c in pairs if c.disagrees]
-    console.print(f"  turns between poses: {len(pairs)}; misfit median {np.median(misfit):.2g} deg, largest "
-                  f"{worst.residual_deg:.2g} deg ({worst.label}); "
-                  + (f"disagreeing: {', '.join(bad)}" if bad else "none disagrees")
+    z = np.median([np.sqrt(c.noise_chi2 / (2 if c.kind == "pair" else 3)) for c in pairs])
+    beyond = sum(c.beyond_noise for c in pairs)
+    console.print(f"  turns between poses: {len(pairs)}; misfit median {np.median(misfit):.2g} deg ({z:.2g} times "
+                  f"its noise), largest {worst.residual_deg:.2g} deg ({worst.label}); beyond their noise: {beyond} of "
+                  f"{len(pairs)}; " + (f"disagreeing with the others: {', '.join(bad)}" if bad else
+                                       "none disagrees with the others")
                   + (f"; left out: {', '.join(g.left_out)}" if g.left_out else ""), highlight=False, soft_wrap=True,
                   markup=False)
+
+
+def _thresholds(det) -> str:
+    """Which multiplier of the stillness thresholds was used, and why."""
+    if len(det.sweep) == 1:
+        return f"stillness thresholds x{det.multiplier:g} those measured at rest, given by --threshold"
+    counts = {n for _, n, _ in det.sweep}
+    tried = ("" if len(counts) == 1 else "; poses found " + ", ".join(f"x{m:g}: {n}" for m, n, _ in det.sweep))
+    return (f"stillness thresholds x{det.multiplier:g} those measured at rest, kept by the accelerometer fit of "
+            f"x{det.sweep[0][0]:g}..x{det.sweep[-1][0]:g}{tried}")
 
 
 def _print_poses(run, windows_from: str) -> None:
@@ -125,6 +138,8 @@ def _print_poses(run, windows_from: str) -> None:
     console.print(f"{len(r.statics)} still poses {source} ({cov.poses} distinct orientations), a {r.kind} session; "
                   f"they cover the sphere with spread {cov.spread:.2f} of 1, largest empty cap {cov.empty_cap_deg:.0f}"
                   f" deg around ({where})", highlight=False, soft_wrap=True)
+    if r.detection is not None:
+        console.print(f"  {_thresholds(r.detection)}", highlight=False, soft_wrap=True)
 
 
 def print_imu_run(run, windows_from: str = "--windows") -> None:

@@ -53,6 +53,9 @@ def imu(
     = False,
     min_static: Annotated[float, typer.Option(
         "--min-static", help="Shortest still pose kept [s].")] = 1.0,
+    threshold: Annotated[Optional[float], typer.Option(
+        "--threshold", help="Multiplier of the stillness thresholds measured at rest, e.g. 100 for poses held by "
+        "hand (default: several are tried and the accelerometer fit picks one).")] = None,
     accel_output_units: Annotated[AccelOutputUnit, typer.Option(
         "--accel-output-units", help="Unit of corrected accelerations.")] = "m/s^2",
     output: Annotated[Optional[Path], typer.Option(
@@ -95,7 +98,7 @@ def imu(
                            t=rec.t if rec.has_time else None)
     run = calibrate_recording(rec, windows=win, gravity=gravity, accel_model=accel_model, gyro_model=gyro_model,
                               g_sensitivity=g_sensitivity, min_static=min_static, output_units=output_units,
-                              accel_output_units=accel_output_units)
+                              accel_output_units=accel_output_units, threshold=threshold)
     inputs = (recording, windows, accel_log)
     doc = judge_plausible(run.calibration.to_document(), implausible(run.calibration), accept_implausible)
     doc, verdict = finish(doc, flags, inputs=inputs)

@@ -10,7 +10,9 @@ method adds):
   internal units, ``internal``: m/s^2 or counts), ``std`` and ``covariance`` of the free entries
   named in ``parameters.names``, ``sensor_axes`` (sensitivity per axis and angles between axes,
   each ``[value, 1-sigma]``), ``fit`` (chi-square summary, ``choice``: why this model);
-* ``poses``: their number, how they cover the sphere, and each pose's gravity direction;
+* ``poses``: their number, how they cover the sphere, each pose's gravity direction, and
+  ``detection``: the stillness thresholds' ``multiplier`` used, whether it was ``given``, and the
+  ``sweep`` tried (``multiplier``, ``poses``, ``residual`` in noise units), or null for given windows;
 * ``gyro_g_sensitivity``: null, or ``matrix`` [gyro input units per m/s^2] and ``std``, applied as
   ``w_true = gyro matrix @ (raw - offset - G a_true)``.
 """
@@ -52,6 +54,13 @@ def _g_sensitivity(result: ImuCalibrationResult, cal) -> dict | None:
             "equation": "w_true = matrix @ (raw - offset - G a_true), a_true in m/s^2"}
 
 
+def _detection(det) -> dict | None:
+    if det is None:
+        return None
+    return {"multiplier": det.multiplier, "given": len(det.sweep) == 1,
+            "sweep": [{"multiplier": m, "poses": n, "residual": r if np.isfinite(r) else None} for m, n, r in det.sweep]}
+
+
 def accelerometer_section(result: ImuCalibrationResult, rec, cal, accel_out: str, gravity: float) -> dict:
     """The ``accelerometer`` section (see the module notes)."""
     from .run import accel_scale
@@ -73,6 +82,7 @@ def accelerometer_section(result: ImuCalibrationResult, rec, cal, accel_out: str
         "covariance": a.covariance.tolist(),
         "sensor_axes": {k: list(v) for k, v in a.sensor_axes().items()},
         "fit": {**a.fit.to_dict(), "choice": list(a.choice)},
-        "poses": {"count": len(result.statics), **cov.to_dict(), "directions": a.directions.tolist()},
+        "poses": {"count": len(result.statics), **cov.to_dict(), "directions": a.directions.tolist(),
+                  "detection": _detection(result.detection)},
         "gyro_g_sensitivity": _g_sensitivity(result, cal),
     }

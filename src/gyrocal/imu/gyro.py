@@ -13,6 +13,7 @@ the scale share one covariance; the accelerometer's own uncertainty is carried i
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Literal, get_args
 
@@ -55,10 +56,13 @@ class PairCheck:
     residual_deg : float
         Size of the misfit [deg].
     chi2 : float
-        Of this equation group (2 dof for a pair, 3 for a turn).
+        Of this equation group (2 dof for a pair, 3 for a turn), against the scatter of its kind
+        (the noise model times the group's noise factor).
     p_value : float
     poses : (int, int) or None
         Indices of the two still poses of a pair.
+    noise_chi2 : float
+        The same against the noise model alone (NaN: not known).
     """
 
     kind: str
@@ -70,14 +74,27 @@ class PairCheck:
     chi2: float
     p_value: float
     poses: tuple[int, int] | None = None
+    noise_chi2: float = math.nan
 
     @property
     def disagrees(self) -> bool:
+        """Whether it disagrees with the others of its kind (an outlier among them)."""
         return self.p_value < DISAGREE_P
+
+    @property
+    def noise_p(self) -> float:
+        """p-value of the misfit against the noise model alone."""
+        return float(stats.chi2.sf(self.noise_chi2, 2 if self.kind == "pair" else 3))
+
+    @property
+    def beyond_noise(self) -> bool:
+        """Whether the misfit is beyond the noise model (whatever the others do)."""
+        return bool(self.noise_p < DISAGREE_P)
 
     def to_dict(self) -> dict:
         return {k: getattr(self, k) for k in ("kind", "label", "t_start", "t_stop", "angle_deg", "residual_deg",
-                                              "chi2", "p_value")} | {"disagrees": self.disagrees,
+                                              "chi2", "p_value", "noise_chi2")} | {
+            "disagrees": self.disagrees, "noise_p": self.noise_p, "beyond_noise": self.beyond_noise,
                                                                      "poses": None if self.poses is None
                                                                      else list(self.poses)}
 
@@ -160,7 +177,7 @@ def _checks(prob: GyroProblem, p, model, with_g, statics, accel: AccelFit, means
             chi2 = float(np.sum(ri**2 / vi))
             out.append(PairCheck("pair", f"pose {i + 1} -> {j + 1}", statics[i].t_stop, statics[j].t_start,
                                  float(np.degrees(ang)), float(np.degrees(np.linalg.norm(ri) * s)), chi2,
-                                 float(stats.chi2.sf(chi2, 2)), (int(i), int(j))))
+                                 float(stats.chi2.sf(chi2, 2)), (int(i), int(j)), chi2 * prob.factors[1] ** 2))
     if prob.turns:
         r = prob.turn_residuals(a, b, g).reshape(-1, 3)
         vec = prob.turn_vectors(a, b, g)
@@ -169,7 +186,7 @@ def _checks(prob: GyroProblem, p, model, with_g, statics, accel: AccelFit, means
             chi2 = float(ri @ ri)
             out.append(PairCheck("turn", tu.label or f"turn at sample {tu.start}", float(span[0]), float(span[1]),
                                  float(np.degrees(np.linalg.norm(v))), float(np.degrees(np.linalg.norm(miss))),
-                                 chi2, float(stats.chi2.sf(chi2, 3))))
+                                 chi2, float(stats.chi2.sf(chi2, 3)), None, chi2 * prob.factors[2] ** 2))
     return tuple(out)
 
 
@@ -298,6 +315,22 @@ def _with_g(prob, solution, ctx, choice):
     return (m, p_g, r_g, jac_g, q_g, s_g), True, choice + ["g-sensitivity: fitted from the still poses"]
 
 
+#: Turns whose median misfit is this many times their noise were not measured by the gyro as the poses show.
+FAR_BEYOND = 5.0
+
+
+def _beyond_noise(checks) -> tuple[str, ...]:
+    """One warning when the turns miss far beyond their noise (then none stands out from the others)."""
+    z = np.array([math.sqrt(c.noise_chi2 / (2 if c.kind == "pair" else 3)) for c in checks])
+    if not len(z) or not np.median(z) > FAR_BEYOND:
+        return ()
+    deg = np.median([c.residual_deg for c in checks])
+    return (f"gyro: the turns miss by a median {deg:.2g} deg, {np.median(z):.2g} times their noise, and "
+            f"{sum(c.beyond_noise for c in checks)} of {len(checks)} are beyond it: the gyro did not measure the "
+            "turns the poses show (a log glued from parts, lost samples, a wrong rate or unit); do not trust "
+            "this result",)
+
+
 def _finish(prob, solution, choice, ctx: _Context) -> GyroFit:
     with_g = False
     if ctx.g_sensitivity:
@@ -315,7 +348,7 @@ def _finish(prob, solution, choice, ctx: _Context) -> GyroFit:
                 "the board may have moved during a pose, or the gyro saturated"
                 for c in checks if c.disagrees)
     q = _fit.FitQuality(q.chi2, q.dof, q.p_value, q.birge_ratio, q.covariance_scaled or bool(notes),
-                        q.warnings + notes + bad)
+                        q.warnings + notes + _beyond_noise(checks) + bad)
     return GyroFit(model=m, matrix=a, offset=b, g_sensitivity=g, covariance=cov, fit=q, checks=checks,
                    choice=tuple(choice), noise_factors=dict(zip(GROUPS, prob.factors[:2].tolist())),
                    left_out=ctx.left_out)

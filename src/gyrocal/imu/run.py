@@ -112,7 +112,8 @@ def accel_scale(units: str, sensitivity: float | None, gravity: float) -> float:
 
 def calibrate_recording(rec: Recording, *, windows=None, gravity: float = STANDARD_GRAVITY, accel_model="auto",
                         gyro_model="auto", g_sensitivity: bool = False, min_static: float = 1.0,
-                        output_units: str | None = None, accel_output_units: str = "m/s^2") -> ImuRun:
+                        output_units: str | None = None, accel_output_units: str = "m/s^2",
+                        threshold: float | None = None) -> ImuRun:
     """Calibrate the gyro and the accelerometer of a hand session.
 
     Parameters
@@ -123,7 +124,7 @@ def calibrate_recording(rec: Recording, *, windows=None, gravity: float = STANDA
         Still poses and turns chosen by hand (imucal's section list makes a Ferraris session).
     gravity : float
         Local gravity [m/s^2] (it is also one ``g`` for readings and output in g).
-    accel_model, gyro_model, g_sensitivity, min_static :
+    accel_model, gyro_model, g_sensitivity, min_static, threshold :
         See :func:`gyrocal.imu.session.calibrate_imu`.
     output_units : {"rad/s", "deg/s"}, optional
         Of the corrected rates; default the data's, deg/s for counts.
@@ -143,7 +144,8 @@ def calibrate_recording(rec: Recording, *, windows=None, gravity: float = STANDA
     clock = tb.clock_times()
     result = calibrate_imu(rec.t if clock is None else clock, rec.gyro, rec.accel, gravity=gravity, windows=windows,
                            accel_model=accel_model, gyro_model=gyro_model, g_sensitivity=g_sensitivity,
-                           min_static=min_static, gaps=[g.index for g in tb.gaps if g.lost > MAX_LOST])
+                           min_static=min_static, gaps=[g.index for g in tb.gaps if g.lost > MAX_LOST],
+                           breaks=tb.breaks, threshold=threshold)
     return ImuRun(result, _calibration(result, rec, tb, out_units, accel_output_units, gravity), tb)
 
 

@@ -23,6 +23,7 @@ from typing import Literal
 import numpy as np
 
 from .._validation import at_least, finite_array, positive
+from ..breaks import spans_break, split_spans
 from ..errors import InputError, SegmentationError
 from ..units import STANDARD_GRAVITY
 from ..windows import Window
@@ -31,6 +32,7 @@ from .accel import AccelFit, fit_accelerometer
 from .gyro import GyroFit, Turn, fit_gyroscope
 from .poses import Coverage, coverage
 from .statics import Static, StaticDetection, detect_statics, summarise_statics
+from .sweep import sweep_statics
 
 __all__ = ["FERRARIS_POSES", "ImuCalibrationResult", "calibrate_imu"]
 
@@ -106,12 +108,16 @@ def _rate(s: Static) -> float:
     return (s.count - 1) / max(s.duration, 1e-12)
 
 
-def _ferraris_turns(t, gyro, accel_raw, windows, accel: AccelFit, statics) -> tuple[list[Turn], list[str]]:
+def _ferraris_turns(t, gyro, accel_raw, windows, accel: AccelFit, statics, breaks=()) -> tuple[list[Turn], list[str]]:
     """Known-angle turns, each about the vertical measured in the poses beside it."""
-    det = detect_statics(t, gyro, accel_raw, min_duration=0.5)
+    det = detect_statics(t, gyro, accel_raw, min_duration=0.5, breaks=breaks)
     turns, notes = [], []
     for w in windows:
         if w.kind != "rotation":
+            continue
+        if spans_break(w.start, w.stop, breaks):
+            notes.append(f"turn {w.label or w.start}: the log is not contiguous inside it (a break at sample "
+                         f"{next(b for b in breaks if w.start < b < w.stop)}); not used")
             continue
         angle = abs(w.angle) if math.isfinite(w.angle) else 2 * math.pi
         found = _neighbour_axis(w, det.statics, accel)
@@ -130,19 +136,41 @@ def _ferraris_turns(t, gyro, accel_raw, windows, accel: AccelFit, statics) -> tu
     return turns, notes
 
 
-def _pairs_without_gaps(statics, gaps) -> tuple[np.ndarray, list[tuple[int, int]]]:
-    """Consecutive pose pairs whose move holds no gap, and the ones left out."""
-    gaps = np.asarray(list(gaps), dtype=int)
-    keep, lost = [], []
+def _pairs_without_gaps(statics, gaps, breaks=()) -> tuple[np.ndarray, list[str]]:
+    """Consecutive pose pairs whose move holds no gap and no break, and why the others were left out."""
+    gaps, breaks = np.asarray(list(gaps), dtype=int), np.asarray(list(breaks), dtype=int)
+    keep, notes = [], []
     for i in range(len(statics) - 1):
         a, b = statics[i].stop - 1, statics[i + 1].start
-        (lost if np.any((gaps > a) & (gaps <= b)) else keep).append((i, i + 1))
-    return np.array(keep, dtype=int).reshape(-1, 2), lost
+        if np.any((breaks > a) & (breaks <= b)):
+            notes.append(f"pose {i + 1} -> {i + 2} left out: the log is not contiguous in the move between them "
+                         f"(a break at sample {int(breaks[(breaks > a) & (breaks <= b)][0])})")
+        elif np.any((gaps > a) & (gaps <= b)):
+            notes.append(f"pose {i + 1} -> {i + 2} left out: samples are missing in the move between them")
+        else:
+            keep.append((i, i + 1))
+    return np.array(keep, dtype=int).reshape(-1, 2), notes
+
+
+def _given_statics(t, gyro, accel, windows, breaks) -> tuple[tuple[Static, ...], list[str]]:
+    """The still windows given, each cut to its longest part where a break falls inside it."""
+    spans, notes = [], []
+    for w in sorted((w for w in windows if w.kind == "static"), key=lambda w: w.start):
+        if w.stop > len(t):
+            raise InputError(f"a still window ends past the recording's {len(t)} samples")
+        a, b = max(split_spans(w.start, w.stop, breaks), key=lambda p: p[1] - p[0])
+        if (a, b) != (w.start, w.stop):
+            notes.append(f"pose {w.label or w.start}: the log is not contiguous inside it; its longest part, samples "
+                         f"{a}-{b}, is used")
+        spans.append((a, b, w.label))
+    statics = summarise_statics(t, gyro, accel, [(a, b) for a, b, _ in spans], [lab for _, _, lab in spans])
+    return statics, notes
 
 
 def calibrate_imu(t, gyro, accel, *, gravity: float = STANDARD_GRAVITY, windows: Sequence[Window] | None = None,
                   accel_model="auto", gyro_model="auto", g_sensitivity: bool = False,
-                  min_static: float = 1.0, gaps: Sequence[int] = ()) -> ImuCalibrationResult:
+                  min_static: float = 1.0, gaps: Sequence[int] = (), breaks: Sequence[int] = (),
+                  threshold: float | None = None) -> ImuCalibrationResult:
     """Calibrate the accelerometer and the gyro of a hand session.
 
     Parameters
@@ -168,6 +196,12 @@ def calibrate_imu(t, gyro, accel, *, gravity: float = STANDARD_GRAVITY, windows:
     gaps : sequence of int
         Samples before which samples are missing (:attr:`gyrocal.timebase.TimeBase.gaps`): a turn
         across a gap has lost angle, so the pose pair around it is left out.
+    breaks : sequence of int
+        Samples that start a new part of a log that is not contiguous (:attr:`gyrocal.timebase.TimeBase.breaks`):
+        no pose, pair or turn spans one.
+    threshold : float or None
+        Multiplier of the detector's stillness thresholds; None tries several
+        (:func:`~gyrocal.imu.statics.sweep_statics`).
     """
     t = finite_array("t", t, ndim=1)
     gyro = finite_array("gyro", gyro, shape_tail=(3,), ndim=2)
@@ -176,26 +210,26 @@ def calibrate_imu(t, gyro, accel, *, gravity: float = STANDARD_GRAVITY, windows:
     if not len(t) == len(gyro) == len(accel):
         raise InputError(f"t, gyro and accel need one row per sample, got {len(t)}, {len(gyro)}, {len(accel)}")
     ferraris = windows is not None and _ferraris_labels(windows)
-    detection = None
+    detection, notes = None, []
     if windows is not None:
-        spans = sorted((w.start, w.stop, w.label) for w in windows if w.kind == "static")
-        if any(b > len(t) for _, b, _ in spans):
-            raise InputError(f"a still window ends past the recording's {len(t)} samples")
-        statics = summarise_statics(t, gyro, accel, [(a, b) for a, b, _ in spans], [lab for _, _, lab in spans])
+        statics, notes = _given_statics(t, gyro, accel, windows, breaks)
     else:
-        detection = detect_statics(t, gyro, accel, min_duration=at_least("min_static", min_static, 0.0, " s"))
+        detection = sweep_statics(t, gyro, accel, min_duration=at_least("min_static", min_static, 0.0, " s"),
+                                  breaks=breaks, gravity=gravity, accel_model=accel_model,
+                                  multiplier=None if threshold is None else positive("threshold", threshold))
         statics = detection.statics
     if not statics:
         raise SegmentationError(f"no still pose of {min_static:g} s or more was found; hold the board still "
-                                "between turns (rest it on a table) for 2 s or more in each orientation")
+                                "between turns (rest it on a table) for 2 s or more in each orientation, or raise "
+                                "--threshold (multiplier of the stillness thresholds)")
     means = np.array([s.accel_mean for s in statics])
     se = np.array([s.accel_se for s in statics])
     directions = np.array([FERRARIS_POSES[s.label] for s in statics]) if ferraris else None
     afit = fit_accelerometer(means, se, gravity=gravity, model=accel_model, directions=directions)
     force = afit.correct(accel)
-    turns, notes = (_ferraris_turns(t, gyro, accel, windows, afit, statics) if ferraris else ([], []))
-    pairs, lost = _pairs_without_gaps(statics, gaps)
-    notes += [f"pose {i + 1} -> {j + 1} left out: samples are missing in the move between them" for i, j in lost]
+    turns, turn_notes = (_ferraris_turns(t, gyro, accel, windows, afit, statics, breaks) if ferraris else ([], []))
+    pairs, pair_notes = _pairs_without_gaps(statics, gaps, breaks)
+    notes += turn_notes + pair_notes
     gfit = fit_gyroscope(t, gyro, force, statics, afit, pairs=pairs, turns=turns, model=gyro_model,
                          g_sensitivity=g_sensitivity)
     cov = coverage(afit.directions)

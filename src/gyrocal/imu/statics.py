@@ -36,6 +36,8 @@ __all__ = ["Static", "StaticDetection", "detect_statics", "long_run_ratio", "sum
 _QUIET_PERCENTILE = 5.0
 _QUIET_FACTOR = 3.0
 _FALSE_MOTION = 1e-4
+#: Smallest long-run over per-sample variance ratio taken (tremor's zero-mean swings average out in a pose).
+LRV_FLOOR = 0.1
 
 
 @dataclass(frozen=True)
@@ -100,6 +102,11 @@ class StaticDetection:
         Moving-window length [samples].
     still : ndarray of bool, shape (N,)
         Samples whose centred window is still.
+    multiplier : float
+        Factor on both thresholds (variances) and on the band of the gyro's still level (its square root).
+    sweep : tuple of (float, int, float)
+        Multipliers tried, with the poses each found and the accelerometer fit's residual in noise
+        units (Birge ratio; NaN where no fit) (:func:`~gyrocal.imu.sweep.sweep_statics`); empty when one was given.
     """
 
     statics: tuple[Static, ...]
@@ -109,6 +116,8 @@ class StaticDetection:
     gyro_threshold: float
     window: int
     still: np.ndarray
+    multiplier: float = 1.0
+    sweep: tuple = ()
 
 
 def _moving(x: np.ndarray, w: int) -> tuple[np.ndarray, np.ndarray]:
@@ -153,7 +162,7 @@ def _noise_and_threshold(var: np.ndarray, floor_var: np.ndarray) -> tuple[np.nda
     return noise, stat, threshold
 
 
-def _near_still_level(mean_g: np.ndarray, quiet: np.ndarray) -> np.ndarray:
+def _near_still_level(mean_g: np.ndarray, quiet: np.ndarray, band: float = 6.0) -> np.ndarray:
     """Windows whose mean gyro reading is within 6 robust deviations of the quiet windows' level.
 
     A slow steady turn has little variance but a mean rate. The quiet windows' spread holds the
@@ -165,7 +174,7 @@ def _near_still_level(mean_g: np.ndarray, quiet: np.ndarray) -> np.ndarray:
     level = np.median(q, axis=0)
     spread = MAD_TO_SIGMA * np.median(np.abs(q - level), axis=0)
     spread = np.maximum(spread, 1e-9 * max(float(np.abs(q).max()), np.finfo(float).tiny))
-    return np.all(np.abs(mean_g - level) <= 6.0 * spread, axis=1)
+    return np.all(np.abs(mean_g - level) <= band * spread, axis=1)
 
 
 def long_run_ratio(x: np.ndarray, segments, lags: int) -> np.ndarray:
@@ -173,7 +182,7 @@ def long_run_ratio(x: np.ndarray, segments, lags: int) -> np.ndarray:
 
     Bartlett-weighted autocovariances (Newey and West) up to `lags`, summed over the still
     segments after removing each segment's mean; 1 for white noise, more for low-pass filtered
-    noise. The standard error of a segment mean is ``std * sqrt(ratio / n)``.
+    noise, less (down to :data:`LRV_FLOOR`) for oscillations such as a hand's tremor. The standard error of a segment mean is ``std * sqrt(ratio / n)``.
     """
     g = np.zeros((lags + 1, 3))
     for a, b in segments:
@@ -184,7 +193,8 @@ def long_run_ratio(x: np.ndarray, segments, lags: int) -> np.ndarray:
         return np.ones(3)
     w = 1.0 - np.arange(lags + 1) / (lags + 1.0)
     lrv = g[0] + 2.0 * (w[1:, None] * g[1:]).sum(axis=0)
-    return np.clip(lrv / g[0], 1.0, None)
+    # below 1 where the noise averages out faster than white noise (a hand's tremor, a periodic ripple)
+    return np.clip(lrv / g[0], LRV_FLOOR, None)
 
 
 def summarise_statics(t, gyro, accel, spans, labels=None, *, lags: int | None = None) -> tuple[Static, ...]:
@@ -212,7 +222,8 @@ def summarise_statics(t, gyro, accel, spans, labels=None, *, lags: int | None = 
     return tuple(out)
 
 
-def detect_statics(t, gyro, accel, *, window_s: float = 0.5, min_duration: float = 1.0) -> StaticDetection:
+def detect_statics(t, gyro, accel, *, window_s: float = 0.5, min_duration: float = 1.0, breaks=(),
+                   multiplier: float = 1.0) -> StaticDetection:
     """Find the still intervals of a session from its accelerometer and gyro.
 
     Parameters
@@ -225,6 +236,10 @@ def detect_statics(t, gyro, accel, *, window_s: float = 0.5, min_duration: float
         Moving-window length [s].
     min_duration : float
         Shortest still interval kept [s].
+    breaks : sequence of int
+        Samples that start a new part of a log that is not contiguous: no interval spans one.
+    multiplier : float
+        Factor on the thresholds measured at rest: a hand's tremor needs more than a table's rest.
 
     Returns
     -------
@@ -243,9 +258,13 @@ def detect_statics(t, gyro, accel, *, window_s: float = 0.5, min_duration: float
     mean_g, var_g = _moving(gyro, w)
     noise_a, stat_a, thr_a = _noise_and_threshold(var_a, _variance_floor(accel))
     noise_g, stat_g, thr_g = _noise_and_threshold(var_g, _variance_floor(gyro))
+    m = positive("multiplier", multiplier)
+    thr_a, thr_g = thr_a * m, thr_g * m
     quiet = (stat_a <= thr_a) & (stat_g <= thr_g)
-    still = quiet & _near_still_level(mean_g, quiet)
+    still = quiet & _near_still_level(mean_g, (stat_a <= thr_a / m) & (stat_g <= thr_g / m), 6.0 * np.sqrt(m))
+    for b in breaks:  # a window straddling a break is never still
+        still[max(0, int(b) - w // 2):int(b) + w // 2] = False
     edges = np.flatnonzero(np.diff(np.concatenate(([0], still.view(np.int8), [0]))))
     spans = [(a, b) for a, b in edges.reshape(-1, 2) if t[b - 1] - t[a] >= min_duration]
     statics = summarise_statics(t, gyro, accel, spans) if spans else ()
-    return StaticDetection(statics, np.sqrt(noise_a), np.sqrt(noise_g), thr_a, thr_g, w, still)
+    return StaticDetection(statics, np.sqrt(noise_a), np.sqrt(noise_g), thr_a, thr_g, w, still, m)

@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from .._validation import positive
+from ..breaks import BREAK_S, counter_breaks, find_counter, join_backward_parts
 from ..choices import AccelUnit, SaturationPolicy, values
 from ..errors import InputError, NonFiniteInputError, SaturationError, UnitError
 from ..recording import Recording
@@ -266,19 +267,8 @@ def build_recording(
         raise InputError(f"{source}: readings reach {peak:.3g}, beyond any sensor in any unit; the column "
                          "holds something else (an id, a time stamp, a checksum?)", param="columns",
                          hint="map the gyro's columns with {param} gx=NAME,gy=NAME,gz=NAME")
-    if "t" in data:
-        t, has_time = np.asarray(data["t"], dtype=float), True  # a time column wins over sample_rate
-        t = time_in_seconds(t, time_units, sample_rate, source, [] if notes is None else notes)
-        fs = _check_time(t, source)
-    elif sample_rate is not None:
-        fs = sample_rate
-        # rows dropped for NaN keep their row numbers: a gap in the time base, not samples glued together
-        t, has_time = (np.arange(n) if rows is None else rows.astype(float)) / fs, False
-    else:
-        raise InputError(
-            f"{source}: no time column (t, time, timestamp, ...)", param="sample_rate",
-            hint="give the sample rate ({param} HZ) or map the time column ({param:columns} t=NAME)"
-        )
+    t, has_time, fs, breaks = _time_column(data, extra, n, rows, sample_rate, time_units, source,
+                                           [] if notes is None else notes)
     if check_units:
         _check_units(raw, unit, sensitivity, source, peak=peak)
         _check_accel_units(accel, gravity, source)
@@ -303,6 +293,8 @@ def build_recording(
     if keep is not None:
         fields = {k: (v[keep] if isinstance(v, np.ndarray) else v) for k, v in fields.items()}
         fields["extra"] = {k: np.asarray(v)[keep] for k, v in extra.items()}
+        kept = np.flatnonzero(keep)
+        breaks = tuple(b for b in np.unique(np.searchsorted(kept, breaks)) if 0 < b < len(kept))
     return Recording(
         **fields,
         units="counts" if unit == "counts" and sensitivity is None else "rad/s",
@@ -310,4 +302,40 @@ def build_recording(
         sample_rate=fs,
         has_time=has_time,
         sensitivity=sensitivity,
+        breaks=breaks,
     )
+
+
+def _time_column(data: dict, extra: dict, n: int, rows, sample_rate, time_units, source: str, notes: list):
+    """``(t, has_time, fs, breaks)``: the stamps [s] (parts glued out of order laid end to end), whether they
+    came from the data, the nominal rate and the breaks (:mod:`gyrocal.breaks`)."""
+    breaks: tuple = ()
+    if "t" in data:
+        t, has_time = np.asarray(data["t"], dtype=float), True  # a time column wins over sample_rate
+        t = time_in_seconds(t, time_units, sample_rate, source, notes)
+        if (joined := join_backward_parts(t)) is not None:  # parts glued out of order: laid end to end
+            t, breaks = joined[0], tuple(joined[1])
+        fs = _check_time(t, source)
+    elif sample_rate is not None:
+        fs = sample_rate
+        # rows dropped for NaN keep their row numbers: a gap in the time base, not samples glued together
+        t, has_time = (np.arange(n) if rows is None else rows.astype(float)) / fs, False
+    else:
+        raise InputError(
+            f"{source}: no time column (t, time, timestamp, ...)", param="sample_rate",
+            hint="give the sample rate ({param} HZ) or map the time column ({param:columns} t=NAME)"
+        )
+    t, breaks = _counter_parts(extra, t, has_time, fs, breaks)
+    return t, has_time, fs, breaks
+
+
+def _counter_parts(extra: dict, t: np.ndarray, has_time: bool, fs: float, breaks: tuple):
+    """Breaks read from a sample counter column, joined with `breaks`; without a time column the
+    samples a counter says were lost also move the later stamps (a gap)."""
+    found = find_counter(extra)
+    if found is None:
+        return t, breaks
+    cut, lost = counter_breaks(found[1], BREAK_S * fs)
+    if not has_time and lost.any():
+        t = t + np.cumsum(lost) / fs
+    return t, tuple(sorted({*breaks, *(int(b) for b in cut)}))
