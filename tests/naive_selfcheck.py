@@ -238,13 +238,15 @@ def _late(step, sample, period, gaps) -> int:
     return int(np.count_nonzero(step > limit)) - sum(1 for _, s, _ in gaps if s > limit)
 
 
-def analyse_time(t, *, has_time: bool = True):
-    """:func:`time_facts` in the library's container (for :func:`install`: the pipeline reads a TimeBase)."""
+def analyse_time(t, *, has_time: bool = True, breaks=()):
+    """:func:`time_facts` in the library's container (for :func:`install`: the pipeline reads a TimeBase).
+
+    The reference reads contiguous logs only: the breaks the recording found are passed through."""
     from gyrocal.timebase import TimeBase
     from gyrocal.timegaps import Gap
 
     facts = time_facts(t, has_time=has_time)
-    return TimeBase(**{**facts, "gaps": tuple(Gap(*g) for g in facts["gaps"])})
+    return TimeBase(**{**facts, "gaps": tuple(Gap(*g) for g in facts["gaps"]), "breaks": tuple(breaks)})
 
 
 # -- the calibration's other pieces as they were --

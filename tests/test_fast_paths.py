@@ -213,7 +213,10 @@ _TIMES = ("span", "period", "mean_step", "median_step", "jitter", "clock_start",
 
 
 def _same_time_base(fast: dict, slow: dict, t) -> None:
-    """Counts, decisions and gaps (a gap's step is the same subtraction) exactly; the times to 4 eps max|t|."""
+    """Counts, decisions and gaps (a gap's step is the same subtraction) exactly; the times to 4 eps max|t|.
+
+    The logs here are contiguous (generated so): the reference has no breaks to find, and there must be none."""
+    assert fast.pop("breaks", ()) == () == slow.pop("breaks", ())
     assert {k: v for k, v in fast.items() if k not in _TIMES} == {k: v for k, v in slow.items() if k not in _TIMES}
     tol = 4 * np.finfo(float).eps * float(np.max(np.abs(t)))
     for name in _TIMES:

@@ -14,7 +14,7 @@ import numpy as np
 from .choices import InputUnit, RateUnit
 from .errors import UnitError
 
-__all__ = ["RateUnit", "InputUnit", "RATE_UNITS", "parse_rate_unit", "parse_input_unit", "to_rad_s", "from_rad_s", "unit_factor",
+__all__ = ["RateUnit", "InputUnit", "accel_scale", "RATE_UNITS", "parse_rate_unit", "parse_input_unit", "to_rad_s", "from_rad_s", "unit_factor",
            "input_scale"]
 
 
@@ -70,3 +70,10 @@ def input_scale(input_units: str, sensitivity: float | None, output_units: str) 
     if input_units == "counts":
         return 1.0 if sensitivity is None else unit_factor(output_units) / sensitivity
     return unit_factor(input_units)
+
+
+def accel_scale(units: str, sensitivity: float | None, gravity: float) -> float:
+    """Internal accelerometer units (m/s^2, or counts without a sensitivity) per unit of `units`."""
+    if units == "counts":
+        return 1.0 if sensitivity is None else gravity / sensitivity
+    return {"m/s^2": 1.0, "g": gravity}[units]

@@ -22,7 +22,7 @@ def _nearest(value: float, settings: dict[float, str]) -> str:
 
 
 def _print_accel(run) -> None:
-    from ..imu.run import accel_scale
+    from ..units import accel_scale
 
     a, part = run.result.accel, run.calibration.accelerometer
     units = part["units"]

@@ -63,7 +63,7 @@ def _detection(det) -> dict | None:
 
 def accelerometer_section(result: ImuCalibrationResult, rec, cal, accel_out: str, gravity: float) -> dict:
     """The ``accelerometer`` section (see the module notes)."""
-    from .run import accel_scale
+    from ..units import accel_scale
 
     a = result.accel
     c_in = accel_scale(rec.accel_source_units, rec.accel_sensitivity, gravity)

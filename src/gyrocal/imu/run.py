@@ -21,7 +21,7 @@ from ..models import KG_INDEX, Affine, ScaleBias
 from ..observed import observe
 from ..recording import Recording
 from ..timebase import TimeBase
-from ..units import STANDARD_GRAVITY, parse_rate_unit
+from ..units import STANDARD_GRAVITY, accel_scale, parse_rate_unit
 from .filedoc import accelerometer_section, gyro_fit_section
 from .session import ImuCalibrationResult, calibrate_imu
 
@@ -101,13 +101,6 @@ def _unit_hint(k: np.ndarray, factor: float, big: str, small: str) -> str:
     if abs(ratio * factor - 1) < 0.2:
         return f" (a factor 1/{factor:.3g}: data in {small} read as {big})"
     return ""
-
-
-def accel_scale(units: str, sensitivity: float | None, gravity: float) -> float:
-    """Internal accelerometer units (m/s^2, or counts without a sensitivity) per unit of `units`."""
-    if units == "counts":
-        return 1.0 if sensitivity is None else gravity / sensitivity
-    return {"m/s^2": 1.0, "g": gravity}[units]
 
 
 def calibrate_recording(rec: Recording, *, windows=None, gravity: float = STANDARD_GRAVITY, accel_model="auto",
