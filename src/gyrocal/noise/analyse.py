@@ -77,8 +77,9 @@ def _departures(kind: str, lines) -> list[str]:
     out = []
     for axis, w in zip("xyz", lines):
         if w is not None and np.isfinite(w.depart_tau):
+            offs = ", ".join(f"{100 * off:+.0f} % at {tau:.3g} s" for off, tau in w.offsets)
             out.append(f"{kind} axis {axis}: the Allan deviation leaves the -1/2 line below tau = {w.depart_tau:.3g} s "
-                       f"({100 * w.depart:+.0f} % at {w.depart_at:.3g} s: a filter, quantisation or a short-tau bump); "
+                       f"({offs}: a filter, quantisation or a short-tau bump); "
                        f"the density is fitted over tau {w.tau_min:.3g}-{w.tau_max:.3g} s and read at 1 s")
     return out
 

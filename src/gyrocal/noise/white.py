@@ -39,6 +39,8 @@ KAPPA = 0.5
 RHO_WIDTH = 0.8
 #: Off the line by more than this (and 4 of its sigmas) below the fit: the curve leaves the line.
 DEPART = 0.03
+#: The fit starts at least this factor above the largest tau where the curve is off the line.
+MARGIN = 3.0
 #: Fallback when no point is within tolerance: the closest slope within this.
 _LOOSE = 0.25
 
@@ -46,8 +48,8 @@ _LOOSE = 0.25
 @dataclass(frozen=True)
 class WhiteLine:
     """The fitted -1/2 line: ``value`` at 1 s with its interval and effective dof, the tau range
-    fitted, and where the curve leaves the line at short tau (``depart_tau`` below which, with
-    ``depart`` the relative offset of the worst point, at ``depart_at``), NaN when it does not."""
+    fitted, and where the curve leaves the line at short tau: ``depart_tau`` below which (NaN when
+    it does not), ``offsets`` the worst relative offsets below and above the line as (offset, tau)."""
 
     value: float
     low: float
@@ -56,8 +58,7 @@ class WhiteLine:
     tau_min: float
     tau_max: float
     depart_tau: float = math.nan
-    depart: float = math.nan
-    depart_at: float = math.nan
+    offsets: tuple = ()
 
 
 def _run(ok: np.ndarray, a: int, top: int) -> tuple[int, int]:
@@ -93,7 +94,8 @@ def _rho(lt: np.ndarray) -> np.ndarray:
 
 
 def _bends(taus, adev, dof, s) -> tuple[float, float, float]:
-    """``N^2, D, F`` of ``adev^2 tau = N^2 + D / tau + F tau``; D, F zero unless over 2 of their sigmas."""
+    """``N^2, D, F`` of ``adev^2 tau = N^2 + D / tau + F tau``; D zero unless over 3 of its sigmas, F 2
+    (a false D costs the short taus' dof, a false F only the long taus', which weigh little)."""
     y = adev**2 * taus
     x = np.column_stack([np.ones(len(taus)), 1.0 / taus, taus])
     w = dof / y**2  # var(adev^2) = 2 adev^4 / edf
@@ -102,7 +104,7 @@ def _bends(taus, adev, dof, s) -> tuple[float, float, float]:
     coef = inv @ xtw @ y
     cov_y = np.outer(2 * s * y, 2 * s * y) * _rho(np.log(taus))  # the points correlate
     sd = np.sqrt(np.diag(inv @ xtw @ cov_y @ xtw.T @ inv))
-    n2, d, f = (c if k == 0 or abs(c) > 2 * e else 0.0 for k, (c, e) in enumerate(zip(coef, sd)))
+    n2, d, f = (c if abs(c) > z * e else 0.0 for c, e, z in zip(coef, sd, (0.0, 3.0, 2.0)))
     return n2, d, f
 
 
@@ -124,14 +126,29 @@ def _trim(taus, adev, dof, s, lo, hi, a) -> tuple[int, int]:
     return best, best
 
 
-def _departure(taus, adev, s, lo, value, s_fit) -> tuple[float, float, float]:
-    """Below the fit: the largest tau off the line by over DEPART and 4 sigmas, the worst offset, its tau."""
-    off = adev[:lo] * np.sqrt(taus[:lo]) / value - 1.0
-    bad = np.flatnonzero(np.abs(off) > np.maximum(DEPART, 4 * np.hypot(s[:lo], s_fit)))
+def _fit(lt, adev, dof, s, lo, hi) -> tuple[float, float]:
+    """ln N of the edf-weighted -1/2 line over [lo, hi], and its sigma from the correlated points."""
+    sl = slice(lo, hi + 1)
+    w = dof[sl] / dof[sl].sum()
+    var = float(w @ (_rho(lt[sl]) * np.outer(s[sl], s[sl])) @ w)  # correlated points: not 1 / sum(edf)
+    return float(np.sum(w * (np.log(adev[sl]) + 0.5 * lt[sl]))), math.sqrt(var)
+
+
+def _off_line(lt, adev, s, ln_n, s_fit, limit: float = 3.0) -> np.ndarray:
+    """Points off the line by more than `limit` sigmas (theirs and the fit's), and DEPART."""
+    off = np.log(adev) + 0.5 * lt - ln_n
+    return np.abs(off) > np.maximum(DEPART if limit > 3 else 0.0, limit * np.hypot(s, s_fit))
+
+
+def _departure(taus, adev, s, lo, ln_n, s_fit) -> tuple[float, tuple]:
+    """Below the fit: the largest tau off the line (over DEPART and 4 sigmas), the worst offsets down and up."""
+    lt = np.log(taus[:lo])
+    bad = np.flatnonzero(_off_line(lt, adev[:lo], s[:lo], ln_n, s_fit, 4.0))
     if not len(bad):
-        return math.nan, math.nan, math.nan
-    worst = int(np.argmax(np.abs(off)))
-    return float(taus[bad[-1]]), float(off[worst]), float(taus[worst])
+        return math.nan, ()
+    off = adev[:lo] * np.sqrt(taus[:lo]) / math.exp(ln_n) - 1.0
+    worst = [int(i) for i in (np.argmin(off), np.argmax(off)) if i in bad]
+    return float(taus[bad[-1]]), tuple((float(off[i]), float(taus[i])) for i in dict.fromkeys(worst))
 
 
 def fit_white_line(taus, adev, fs: float, n: int, *, i_min: int, mult: float, level: float) -> WhiteLine | None:
@@ -151,11 +168,20 @@ def fit_white_line(taus, adev, fs: float, n: int, *, i_min: int, mult: float, le
     a, tol = found
     lo, hi = _run(off <= tol, a, max(i_min, 1))
     lo, hi = _trim(taus, adev, dof, s, lo, hi, a)
-    sl = slice(lo, hi + 1)
-    w = dof[sl] / dof[sl].sum()
-    value = math.exp(float(np.sum(w * (np.log(adev[sl]) + 0.5 * lt[sl]))))
-    var = float(w @ (_rho(lt[sl]) * np.outer(s[sl], s[sl])) @ w)  # correlated points: not 1 / sum(edf)
-    dof_fit = 1.0 / (2.0 * var)
+    ln_n, s_fit = _fit(lt, adev, dof, s, lo, hi)
+    for _ in range(8):  # what the bends' model misses (a bump's skirt): narrow past points off the line
+        bad = np.flatnonzero(_off_line(lt, adev, s, ln_n, s_fit)[lo:hi + 1]) + lo
+        below, above = bad[bad < a], bad[bad > a]
+        if not (len(below) or len(above)):
+            break
+        lo, hi = (below[-1] + 1 if len(below) else lo), (above[0] - 1 if len(above) else hi)
+        ln_n, s_fit = _fit(lt, adev, dof, s, lo, hi)
+    depart = _departure(taus, adev, s, lo, ln_n, s_fit)
+    if np.isfinite(depart[0]) and taus[lo] < MARGIN * depart[0]:  # a bump's skirt reaches past where it shows
+        lo = min(int(np.searchsorted(taus, MARGIN * depart[0])), a)
+        ln_n, s_fit = _fit(lt, adev, dof, s, lo, hi)
+        depart = _departure(taus, adev, s, lo, ln_n, s_fit)
+    dof_fit = 1.0 / (2.0 * s_fit**2)
+    value = math.exp(ln_n)
     low, high = confidence(value, dof_fit, level)
-    return WhiteLine(value, low, high, dof_fit, float(taus[lo]), float(taus[hi]),
-                     *_departure(taus, adev, s, lo, value, math.sqrt(var)))
+    return WhiteLine(value, low, high, dof_fit, float(taus[lo]), float(taus[hi]), *depart)
