@@ -10,7 +10,9 @@ range around 1 s where
   ``adev^2 tau = N^2 + D / tau + F tau`` over that run measures the short-tau departure ``D``
   (filter, quantisation, resonances all fall as 1/tau^2 in the Allan variance once tau is past
   them) and the long-tau one ``F`` (flicker, random walk); points where ``|D/tau|`` or ``|F tau|``
-  shifts adev by more than ``KAPPA`` of its sigma are left out.
+  shifts adev by more than ``KAPPA`` of its sigma are left out;
+* then points off the fitted line by 3 sigmas are cut away (what that model misses, a bump's
+  skirt), and the range starts ``MARGIN`` times above the largest tau where the curve is off it.
 
 The points share the same samples, so their errors correlate. The interval uses the fit's
 variance ``w' C w`` with ``C_ij = s_i s_j rho(tau_i / tau_j)``, ``s_i = 1 / sqrt(2 edf_i)``:
