@@ -36,6 +36,9 @@ def test_noise_then_kalibr_vins_imu_utils(rest, tmp_path):
     assert code == 0, err
     assert "accelerometer" in out and "-0.2" in out  # both tables, with intervals
     report = load(noise, NoiseReport)
+    # datasheet units: ARW = N [rad/s/sqrt(Hz)] x 180/pi x 60 deg/sqrt(h); 5e-4 -> 1.72
+    assert "datasheet" in out and "deg/\u221ah" in out and "deg/h" in out
+    assert f"{np.degrees(report.gyro.density.value[3]) * 60:.3g}" in out
     # the simulation's truth: 0.005 rad/s per sample at 100 Hz, 0.002 m/s^2/sqrt(Hz)
     assert report.gyro.density.value[3] == pytest.approx(5e-4, rel=0.01)
     assert report.accel.density.value[3] == pytest.approx(2e-3, rel=0.01)

@@ -10,7 +10,7 @@ Layout (SI units, recorded in ``units``; ``null`` for a figure not seen)::
                    "temperature": {"min": 24.9, "max": 25.1, "span": 0.2, "unit": "degC"} or null},
       "source": {"file": "static.csv", "gyro_units": "deg/s", "accel_units": "g"},
       "gyroscope": {
-        "x": {"density": {"value": .., "low": .., "high": .., "tau": .., "edf": ..},
+        "x": {"density": {"value": .., "low": .., "high": .., "tau": 1.0, "edf": .., "tau_min": .., "tau_max": ..},
               "bias_instability": {...}, "random_walk": {...}, "random_walk_bound_95": null,
               "noise_std": ..},
         "y": {...}, "z": {...}, "sensor": {...},
@@ -20,6 +20,8 @@ Layout (SI units, recorded in ``units``; ``null`` for a figure not seen)::
       "warnings": [...], "method": "...", "created_by": "gyrocal 0.2.0"
     }
 
+``density.tau_min``/``tau_max`` (the tau range its -1/2 line was fitted over; ``tau`` is 1 s, where
+it is read, ``edf`` the fit's effective dof) came later too: files without them load, with NaN.
 ``analysed.temperature`` (the sensor temperature's range over the analysed stretch, null for a
 log without one) came after version 2 was first written: a version 2 file without it still loads.
 Version 1 files (gyro only, no intervals) are upgraded by :func:`upgrade_v1`, through
@@ -52,8 +54,9 @@ UNITS = {
                       "adev": "m/s^2", "noise_std": "m/s^2", "tau": "s"},
 }
 FIGURES = ("density", "bias_instability", "random_walk")
-METHOD = ("overlapping Allan deviation (allantools.oadev); figures read on the IEEE Std 952 annex C lines; "
-          "intervals from the equivalent degrees of freedom (Greenhall, allantools.edf_greenhall)")
+METHOD = ("overlapping Allan deviation (allantools.oadev); figures read on the IEEE Std 952 annex C lines, the density "
+          "on the -1/2 line fitted over density.tau_min-tau_max and read at tau = 1 s; intervals from the equivalent "
+          "degrees of freedom (Greenhall, allantools.edf_greenhall; the density's from its correlated points)")
 
 
 def _num(x) -> float | None:
@@ -66,6 +69,7 @@ def _sensor_doc(s: SensorNoise, fs: float) -> dict:
     for r, row in enumerate(ROWS):
         entry = {name: {key: _num(getattr(getattr(s, name), key)[r]) for key in ("value", "low", "high", "tau", "edf")}
                  for name in FIGURES}
+        entry["density"].update(tau_min=_num(s.density.tau_min[r]), tau_max=_num(s.density.tau_max[r]))
         entry["random_walk_bound_95"] = _num(s.random_walk_bound[r])
         entry["noise_std"] = _num(std[r])
         doc[row] = entry
@@ -127,6 +131,10 @@ def _sensor_from(doc: dict, key: SensorKind, path) -> SensorNoise:
         cols = [[_value(doc, f"{key}.{row}.{name}.{k}", path, positive=(name == "density" and k == "value"))
                  for k in ("value", "low", "high", "tau", "edf")] for row in ROWS]
         figures[name] = Figure(*np.array(cols).T)
+    fitted = [[_value(doc, f"{key}.{row}.density.{k}", path) if k in doc[key][row]["density"] else math.nan
+               for k in ("tau_min", "tau_max")] for row in ROWS]  # optional: older files lack them
+    d = figures["density"]
+    figures["density"] = Figure(d.value, d.low, d.high, d.tau, d.edf, *np.array(fitted).T)
     bound = [_value(doc, f"{key}.{row}.random_walk_bound_95", path) for row in ROWS]
     adev = []
     for row in ROWS:

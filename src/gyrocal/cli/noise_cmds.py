@@ -54,6 +54,25 @@ def _table(title: str, sensor, fs: float, unit: str, factor: float):
     return table
 
 
+#: rad/s/sqrt(Hz) -> deg/sqrt(h) and rad/s -> deg/h, a datasheet's units.
+_ARW = 180.0 / math.pi * 60.0
+_DEG_H = 180.0 / math.pi * 3600.0
+
+
+def _datasheet(sensor):
+    """The gyro's angle random walk [deg/sqrt(h)], bias instability [deg/h] and the density's fitted range."""
+    from rich.table import Table
+
+    table = Table(title="gyro in datasheet units", caption="ARW: the -1/2 fit, at 1 s")
+    for col in ("axis", "ARW\ndeg/\u221ah", "bias inst.\ndeg/h", "-1/2 fit\n\u03c4 range s"):
+        table.add_column(col, justify="right", no_wrap=True)
+    d = sensor.density
+    for r, name in enumerate(("x", "y", "z", "sensor")):
+        fit = f"{d.tau_min[r]:.3g}-{d.tau_max[r]:.3g}" if math.isfinite(d.tau_min[r]) else "-"
+        table.add_row(name, _cell(d, r, _ARW, "-"), _cell(sensor.bias_instability, r, _DEG_H, "not reached"), fit)
+    return table
+
+
 @app.command()
 @station_flags
 def noise(
@@ -111,6 +130,7 @@ def noise(
     fs = report.sample_rate
     head = f"{report.duration:.0f} s at {fs:g} Hz, {100 * report.confidence:.0f} % intervals"
     console.print(_table(f"{recording.name}: gyro, {head}", report.gyro, fs, shown, 1.0 / unit_factor(shown)))
+    console.print(_datasheet(report.gyro))
     if report.accel is not None:
         console.print(_table(f"{recording.name}: accelerometer", report.accel, fs, "m/s^2", 1.0))
     if json_out is not None:

@@ -18,9 +18,11 @@
   variance grows at half the continuous rate with that ``n``: use ``inflate`` >= sqrt(2) for
   the same growth.
 * **imu_utils** ``<name>_imu_param.yaml`` (``src/imu_an.cpp``, ``writeYAML``): per axis and
-  ``avg-axis`` (the mean of the three) ``gyr_n``/``acc_n``, the Allan deviation at tau = 1 s
-  (the white-noise density), and ``gyr_w``/``acc_w``, the *minimum* of the Allan deviation
-  (``getBiasInstability``: the floor itself, not divided by 0.664, and not a random walk).
+  ``avg-axis`` (the mean of the three) ``gyr_n``/``acc_n``, the white-noise density at tau = 1 s
+  (gyrocal's: the fitted -1/2 line there, with its range in a comment), and ``gyr_w``/``acc_w``,
+  the *minimum* of the Allan deviation (``getBiasInstability``: the floor itself, not divided by
+  0.664, and not a random walk); an axis whose curve never turns up gets the 95 % upper limit of
+  its lowest point, said in a comment.
 
 Kalibr and VINS need the accelerometer: without it in the noise file the values must come
 from the caller (never invented). ``inflate`` multiplies every noise value (the safety factor
@@ -37,6 +39,7 @@ import numpy as np
 from .._version import __version__
 from ..errors import InputError
 from ..noise import BI_FACTOR, NoiseReport
+from ..noise.allan import confidence, edf
 
 __all__ = ["imu_utils_yaml", "kalibr_yaml", "vins_yaml", "vio_values"]
 
@@ -61,6 +64,14 @@ def _walk(sensor, name: str, given: float | None, use_bound: bool) -> tuple[floa
                                              f"{bound:.3g} ({{param}})")
 
 
+def _density_note(d, r: int = _SENSOR) -> str:
+    """Where a density came from: its fitted range (older files: the point it was read at)."""
+    lo, hi = d.tau_min[r], d.tau_max[r]
+    where = (f"fitted over tau {lo:.3g}-{hi:.3g} s, read at tau = 1 s" if math.isfinite(lo)
+             else f"at tau = {d.tau[r]:.4g} s")
+    return f"Allan -1/2 line {where}, interval {d.low[r]:.4g}-{d.high[r]:.4g}"
+
+
 def vio_values(report: NoiseReport, *, inflate: float = 1.0, accel_noise_density: float | None = None,
                accel_random_walk: float | None = None, gyro_random_walk: float | None = None,
                use_bound: bool = False) -> dict[str, tuple[float, str]]:
@@ -80,15 +91,13 @@ def vio_values(report: NoiseReport, *, inflate: float = 1.0, accel_noise_density
                               "give both {param} [m/s^2/sqrt(Hz)] and the random walk [m/s^3/sqrt(Hz)]")
     g = report.gyro
     d = g.density
-    out = {"gyroscope_noise_density": (float(d.value[_SENSOR]), f"Allan -1/2 line at tau = {d.tau[_SENSOR]:.4g} s, "
-                                       f"interval {d.low[_SENSOR]:.4g}-{d.high[_SENSOR]:.4g}"),
+    out = {"gyroscope_noise_density": (float(d.value[_SENSOR]), _density_note(d)),
            "gyroscope_random_walk": _walk(g, "gyro_random_walk", gyro_random_walk, use_bound)}
     if accel_noise_density is not None:
         out["accelerometer_noise_density"] = (float(accel_noise_density), "given by the user")
     else:
         ad = a.density
-        out["accelerometer_noise_density"] = (float(ad.value[_SENSOR]), f"Allan -1/2 line, interval "
-                                              f"{ad.low[_SENSOR]:.4g}-{ad.high[_SENSOR]:.4g}")
+        out["accelerometer_noise_density"] = (float(ad.value[_SENSOR]), _density_note(ad))
     out["accelerometer_random_walk"] = _walk(a, "accel_random_walk", accel_random_walk, use_bound)
     for key, (value, note) in out.items():
         if not (math.isfinite(value) and value > 0):
@@ -151,14 +160,25 @@ def vins_yaml(report: NoiseReport, *, update_rate: float | None = None, inflate:
     return "\n".join(lines) + "\n"
 
 
-def _imu_utils_block(sensor, short: str, unit: str, inflate: float) -> list[str]:
-    if not np.all(np.isfinite(sensor.bias_instability.value[:3])):
-        raise InputError(f"imu_utils' {short}_w is the floor of the {sensor.kind} Allan deviation, and this log is too "
-                         "short to reach it on every axis: log longer")
-    n = sensor.density.value[:3] * inflate
+def _floor_bound(sensor, i: int, report: NoiseReport) -> float:
+    """95 % upper limit of an axis's lowest Allan deviation point: its floor lies lower still."""
+    j = int(np.argmin(sensor.adev[i]))
+    dof = edf(-1, round(sensor.taus[j] * report.sample_rate), report.samples)
+    return confidence(float(sensor.adev[i, j]), dof, 0.95)[1]
+
+
+def _imu_utils_block(sensor, short: str, unit: str, inflate: float, report: NoiseReport) -> list[str]:
+    d = sensor.density
+    n = d.value[:3] * inflate
     w = sensor.bias_instability.value[:3] * BI_FACTOR * inflate  # the floor itself, as imu_utils writes it
+    notes = [f"# {ax}-axis {short}_n: {_density_note(d, i)}" for i, ax in enumerate("xyz")]
+    for i, ax in enumerate("xyz"):
+        if not math.isfinite(w[i]):
+            w[i] = _floor_bound(sensor, i, report) * inflate
+            notes.append(f"# {ax}-axis {short}_w: the curve never turns up (still falls at tau = {sensor.taus[-1]:.4g} "
+                         "s): 95 % upper bound of its lowest point, the floor is lower")
     rows = [("avg-axis", n.mean(), w.mean())] + [(f"{ax}-axis", n[i], w[i]) for i, ax in enumerate("xyz")]
-    out = [f"{short.capitalize()}:", f'   unit: " {unit}"']
+    out = [f"{short.capitalize()}:", *notes, f'   unit: " {unit}"']
     for name, nv, wv in rows:
         out += [f"   {name}:", f"      {short}_n: {nv:.16e}", f"      {short}_w: {wv:.16e}"]
     return out
@@ -169,11 +189,12 @@ def imu_utils_yaml(report: NoiseReport, *, name: str = "imu", inflate: float = 1
     if not (math.isfinite(inflate) and inflate >= 1):
         raise InputError(f"{{param}} must be a factor >= 1, got {inflate!r}", param="inflate", value=inflate)
     lines = ["%YAML:1.0", *_source_lines(report, inflate),
-             "# *_n: Allan deviation at tau = 1 s (white-noise density); *_w: minimum of the Allan deviation",
+             "# *_n: white-noise density, the -1/2 line fitted to the Allan deviation and read at tau = 1 s; "
+             "*_w: minimum of the Allan deviation",
              "---", "type: IMU", f"name: {name}"]
-    lines += _imu_utils_block(report.gyro, "gyr", "rad/s", inflate)
+    lines += _imu_utils_block(report.gyro, "gyr", "rad/s", inflate, report)
     if report.accel is None:
         lines.append("# no accelerometer in the log: no Acc block")
     else:
-        lines += _imu_utils_block(report.accel, "acc", "m/s^2", inflate)
+        lines += _imu_utils_block(report.accel, "acc", "m/s^2", inflate, report)
     return "\n".join(lines) + "\n"

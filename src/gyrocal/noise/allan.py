@@ -11,6 +11,7 @@ random walk), the three lines an IMU noise analysis reads (IEEE Std 952, annex C
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -70,6 +71,11 @@ def allan_deviation(rates, sample_rate: float, *, points_per_decade: int = 12) -
     return np.asarray(taus), np.asarray(out)
 
 
+@functools.lru_cache(maxsize=4096)  # the density fit asks for every point, four rows alike
+def _edf(alpha: int, m: int, n: int) -> float:
+    return float(_allantools().edf_greenhall(alpha=alpha, d=2, m=m, N=n + 1, overlapping=True))
+
+
 def edf(alpha: int, m: int, n: int) -> float:
     """Equivalent degrees of freedom of an overlapping Allan variance.
 
@@ -83,7 +89,7 @@ def edf(alpha: int, m: int, n: int) -> float:
         Samples in the record.
     """
     # Greenhall counts phase points: n rate samples integrate to n + 1 of them.
-    return float(_allantools().edf_greenhall(alpha=alpha, d=2, m=int(m), N=int(n) + 1, overlapping=True))
+    return _edf(int(alpha), int(m), int(n))
 
 
 def confidence(dev: float, dof: float, level: float = ONE_SIGMA) -> tuple[float, float]:

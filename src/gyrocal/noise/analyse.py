@@ -72,13 +72,26 @@ def _temperature(temp, n: int, start: int, stop: int, found: list[str]) -> tuple
     return low, high
 
 
-def _sensor(kind, x, fs, level) -> SensorNoise:
+def _departures(kind: str, lines) -> list[str]:
+    """Where an axis's curve leaves the fitted -1/2 line at short tau, one message each."""
+    out = []
+    for axis, w in zip("xyz", lines):
+        if w is not None and np.isfinite(w.depart_tau):
+            offs = ", ".join(f"{100 * off:+.0f} % at {tau:.3g} s" for off, tau in w.offsets)
+            out.append(f"{kind} axis {axis}: the Allan deviation leaves the -1/2 line below tau = {w.depart_tau:.3g} s "
+                       f"({offs}: a filter, quantisation or a short-tau bump); "
+                       f"the density is fitted over tau {w.tau_min:.3g}-{w.tau_max:.3g} s and read at 1 s")
+    return out
+
+
+def _sensor(kind, x, fs, level, found: list[str]) -> SensorNoise:
     taus, adev = allan_deviation(x, fs)
-    curves, density, bias, walk, bound = read_figures(taus, adev, fs, len(x), level=level)
+    curves, density, bias, walk, bound, lines = read_figures(taus, adev, fs, len(x), level=level)
     if not np.all(density.value > 0):
         bad = "xyz"[int(np.argmin(np.nan_to_num(density.value[:3], nan=0.0) > 0))]
         raise InputError(f"the {kind} has no white-noise (-1/2 slope) region on axis {bad}, so no noise density can "
                          "be read: the data look filtered or oversampled; log the sensor's own output rate")
+    found.extend(_departures(kind, lines))
     return SensorNoise(kind, taus, curves, density, bias, walk, bound)
 
 
@@ -139,10 +152,10 @@ def characterise(gyro, sample_rate: float, *, accel=None, temp=None, motion: Mot
         found.append(f"{what}: analysed the longest still stretch, {start / fs:.1f}-{stop / fs:.1f} s "
                      f"({(stop - start) / fs:.1f} s of {len(g) / fs:.1f} s)")
     temperature = _temperature(temp, len(g), start, stop, found)
+    gyro_noise = _sensor("gyroscope", g[start:stop], fs, level, found)
+    accel_noise = None if a is None else _sensor("accelerometer", a[start:stop], fs, level, found)
     for message in found:
         warnings.warn(message, NoiseWarning, stacklevel=2)
-    gyro_noise = _sensor("gyroscope", g[start:stop], fs, level)
-    accel_noise = None if a is None else _sensor("accelerometer", a[start:stop], fs, level)
     return NoiseReport(gyro_noise, accel_noise, fs, stop - start, start / fs, stop / fs, len(g) / fs,
                        motions_left_out=len(still.spans), confidence=level, source=dict(source or {}),
                        warnings=tuple(found), temperature=temperature)

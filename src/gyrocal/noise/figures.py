@@ -3,17 +3,16 @@
 Read as in IEEE Std 952, annex C:
 
 * white-noise density ``N`` (angle random walk for a gyro, velocity random walk for an
-  accelerometer): the -1/2 slope line read at ``tau = 1 s``;
+  accelerometer): the -1/2 slope line fitted where the curve follows it, read at ``tau = 1 s``
+  (:mod:`.white`: the range fitted, the interval from the correlated points, departures);
 * bias instability ``B``: the flat minimum divided by ``sqrt(2 ln 2 / pi) = 0.664``
   (not reached while the curve still falls at the longest averaging time);
 * random walk ``K`` of the bias: the +1/2 slope line read at ``tau = 3 s`` (not seen when
   the curve never turns up). Kalibr's ``*_random_walk`` is this ``K`` (Kalibr wiki, "IMU
   Noise Model": the bias is Brownian motion driven by white noise of that strength).
 
-Each line goes through a point whose local log-log slope matches the line's: for ``N`` the
-shortest averaging time within 0.1 of -1/2 (most degrees of freedom, least of the other
-noises), else the closest slope on the short-tau side of the minimum; for ``K`` the closest
-slope on the long side. A figure is the
+``B`` and ``K`` are read at one point: ``K``'s line goes through the point of the long side
+whose local log-log slope is closest to +1/2. Such a figure is the
 Allan deviation at that point times a fixed factor, so its interval is the point's
 interval (:func:`.allan.confidence`, from the edf of the noise type the line stands for)
 times the same factor. Where ``K`` is not seen, the curve still bounds it: the Allan
@@ -24,12 +23,13 @@ taken at the 95 % upper limit of ``sigma`` and minimised over the long-tau side.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import InputError
 from .allan import confidence, edf
+from .white import fit_white_line
 
 __all__ = ["BI_FACTOR", "Figure", "read_figures"]
 
@@ -50,9 +50,11 @@ class Figure:
     value, low, high : ndarray, shape (4,)
         Estimate and interval for x, y, z and the sensor; NaN where not seen.
     tau : ndarray, shape (4,)
-        Averaging time of the Allan deviation point it was read from [s].
+        Averaging time it was read at [s] (the density: 1 s, on its fitted line).
     edf : ndarray, shape (4,)
-        Equivalent degrees of freedom of that point.
+        Equivalent degrees of freedom (the density: of its fit).
+    tau_min, tau_max : ndarray, shape (4,)
+        The density's fitted range [s]; NaN for the other figures and in older files.
     """
 
     value: np.ndarray
@@ -60,9 +62,11 @@ class Figure:
     high: np.ndarray
     tau: np.ndarray
     edf: np.ndarray
+    tau_min: np.ndarray = field(default_factory=lambda: np.full(4, math.nan))
+    tau_max: np.ndarray = field(default_factory=lambda: np.full(4, math.nan))
 
     def __post_init__(self):
-        for name in ("value", "low", "high", "tau", "edf"):
+        for name in ("value", "low", "high", "tau", "edf", "tau_min", "tau_max"):
             arr = np.array(getattr(self, name), dtype=float)
             if arr.shape != (4,):
                 raise InputError(f"{name} must have shape (4,), got {arr.shape}")
@@ -76,28 +80,21 @@ class Figure:
 
     def scaled(self, factor: float) -> "Figure":
         """The same figure in other units (value and interval times `factor`)."""
-        return Figure(self.value * factor, self.low * factor, self.high * factor, self.tau, self.edf)
+        return Figure(self.value * factor, self.low * factor, self.high * factor, self.tau, self.edf,
+                      self.tau_min, self.tau_max)
 
 
-def _line_point(local: np.ndarray, slope: float, side: np.ndarray, first: bool = False) -> int | None:
-    """The point on `side` whose local slope is closest to `slope` (within tolerance).
-
-    With `first`, the shortest averaging time whose slope is within a tenth of `slope` wins
-    when there is one: it has the most degrees of freedom, and the least of the other noises.
-    """
+def _line_point(local: np.ndarray, slope: float, side: np.ndarray) -> int | None:
+    """The point on `side` whose local slope is closest to `slope` (within tolerance)."""
     if not side.any():
         return None
     cand = np.flatnonzero(side)
-    if first:
-        near = cand[np.abs(local[cand] - slope) <= 0.1]
-        if len(near):
-            return int(near[0])
     idx = cand[np.argmin(np.abs(local[cand] - slope))]
     return int(idx) if abs(local[idx] - slope) <= _SLOPE_TOLERANCE else None
 
 
 def _read_row(taus, adev, fs, n, pooled, level):
-    """Figures (value, low, high, tau, edf) x 3 and the random-walk bound of one curve."""
+    """Density line, figures (value, low, high, tau, edf) x 2 and the random-walk bound of one curve."""
     local = np.gradient(np.log(adev), np.log(taus))
     i_min = int(np.argmin(adev))
     idx = np.arange(len(taus))
@@ -110,8 +107,7 @@ def _read_row(taus, adev, fs, n, pooled, level):
         return adev[i] * factor, low * factor, high * factor, taus[i], dof
 
     none = (math.nan,) * 5
-    i = _line_point(local, -0.5, idx <= max(i_min, 1), first=True)
-    density = none if i is None else at(i, 0, math.sqrt(taus[i]))
+    density = fit_white_line(taus, adev, fs, n, i_min=i_min, mult=mult, level=level)
     bias = at(i_min, -1, 1.0 / BI_FACTOR) if turned else none
     i = _line_point(local, 0.5, idx >= i_min) if turned else None
     walk = none if i is None else at(i, -2, math.sqrt(3.0 / taus[i]))
@@ -147,6 +143,8 @@ def read_figures(taus, adev, sample_rate: float, n: int, *, level: float):
         In [unit/sqrt(Hz)], [unit], [unit/s/sqrt(Hz)] = [unit/sqrt(s)] per sqrt(s).
     random_walk_bound : ndarray, shape (4,)
         95 % upper bound on the random walk where it is not seen (NaN where it is).
+    lines : list of WhiteLine or None
+        The density fit of each row, with where the curve leaves it at short tau.
     """
     adev = np.asarray(adev, dtype=float)
     if not np.all(adev > 0):
@@ -154,9 +152,13 @@ def read_figures(taus, adev, sample_rate: float, n: int, *, level: float):
                          "(constant, or quantised far coarser than the noise); no noise figure can be read")
     curves = np.vstack([adev, np.sqrt(np.mean(adev**2, axis=0))])
     rows = [_read_row(taus, curves[r], sample_rate, n, r == 3, level) for r in range(4)]
-    figures = []
-    for k in range(3):
+    lines = [row[0] for row in rows]
+    nan = math.nan
+    dens = np.array([(nan,) * 7 if w is None else (w.value, w.low, w.high, 1.0, w.edf, w.tau_min, w.tau_max)
+                     for w in lines])
+    figures = [Figure(*dens.T)]
+    for k in (1, 2):
         cols = np.array([row[k] for row in rows], dtype=float)  # (4, 5)
         figures.append(Figure(*cols.T))
     bound = np.array([row[3] for row in rows])
-    return curves, figures[0], figures[1], figures[2], bound
+    return curves, figures[0], figures[1], figures[2], bound, lines
