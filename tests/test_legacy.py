@@ -14,7 +14,7 @@ from cli_runner import invoke
 
 from gyrocal.calibration import Calibration
 from gyrocal.errors import FileFormatError
-from gyrocal.files import load
+from gyrocal.files import load, to_document
 from gyrocal.io import read_recording
 from gyrocal.legacy import upgrade
 from gyrocal.models import KG_NAMES
@@ -130,7 +130,7 @@ def test_v1_thermal_bias_loads_and_exports_as_it_did(tmp_path):
     old = _old("v1_thermal_bias.json")
     assert old["version"] == 1 and "accelerometer" not in old
     tb = load(DATA / "v1_thermal_bias.json")
-    doc = tb.to_document()
+    doc = to_document(tb)
     assert doc["version"] == 2 and doc["accelerometer"] is None and doc["axes"] == old["axes"]
     for fmt, name, extra in (("px4", "v1_thermal_bias.params", ("--device-id", "7")),
                              ("ardupilot", "v1_thermal_bias.parm", ())):

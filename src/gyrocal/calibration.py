@@ -38,7 +38,6 @@ from ._jsonfile import check_header, get, get_array
 from ._validation import refuse_options
 from ._version import __version__
 from .errors import FileFormatError, InputError, NonPhysicalEstimateError, UnitError
-from .files import register
 from .models import KG_NAMES, Affine, CalibrationModel, ScaleBias
 from .recording import Recording
 from .sections import AccelerometerPart, FitQuality, Observed, section
@@ -50,7 +49,6 @@ __all__ = ["Calibration"]
 _PARAMETERS_KEY = {"scale-bias": "scale_bias", "affine": "affine"}
 
 
-@register
 @dataclass(frozen=True)
 class Calibration:
     """A fitted model together with the units it applies to.

@@ -1,13 +1,13 @@
 """One registry of gyrocal's file kinds: load any file by its ``format`` field, save any kind.
 
-A file kind is a class with ``FORMAT`` (``"gyrocal.calibration"``), ``VERSION`` (the
-version it writes), ``to_document()`` and a classmethod ``from_document(doc, path)``,
-registered with :func:`register`. :func:`load` reads the JSON once, finds the kind by
-``format``, upgrades old versions through :mod:`gyrocal.legacy`, validates and returns
-the object; :func:`save` writes ``obj.to_document()`` atomically.
-
-Kinds register when their module is imported; :data:`KIND_MODULES` names the module of
-each known format, so that loading a file never depends on what was imported before.
+A file kind is a class with ``FORMAT`` (``"gyrocal.calibration"``) and ``VERSION`` (the version it
+writes), whose documents are made and read by ``to_document(obj)`` and ``from_document(doc, path)``:
+the class's own methods, or the functions of a separate document module when the class is core
+numerics (a noise report, a thermal-bias fit). :data:`KINDS` names every built-in kind by module, so
+the registry imports a kind only when it meets its format and no kind imports the registry back
+(no import cycle); :func:`register` adds a kind at run time. :func:`load` reads the JSON once,
+finds the kind by ``format``, upgrades old versions through :mod:`gyrocal.legacy`, validates and
+returns the object; :func:`save` writes the document atomically.
 """
 
 from __future__ import annotations
@@ -20,22 +20,21 @@ from ._jsonfile import read_json, write_json
 from .errors import FileFormatError, InputError
 
 __all__ = [
-    "KIND_MODULES", "FileKind", "from_document", "kinds", "load", "load_calibration", "load_correction", "load_thermal",
-    "register",
-    "save", "save_calibration", "save_thermal",
+    "KINDS", "FileKind", "from_document", "kinds", "load", "load_calibration", "load_correction", "load_thermal",
+    "register", "save", "save_calibration", "save_thermal", "to_document",
 ]
 
-#: Format name -> module that registers its kind (add a line for a new kind).
-KIND_MODULES: dict[str, str] = {
-    "gyrocal.calibration": "gyrocal.calibration",
-    "gyrocal.thermal": "gyrocal.thermal.model",
-    "gyrocal.simulation-truth": "gyrocal.simulation.truth",
-    "gyrocal.noise": "gyrocal.noise_file",
-    "gyrocal.thermal-bias": "gyrocal.thermal_bias_file",
-    "gyrocal.verify": "gyrocal.verify.report",
+#: Format -> (module, class, module of its document functions or None: the class's own methods).
+KINDS: dict[str, tuple[str, str, str | None]] = {
+    "gyrocal.calibration": ("gyrocal.calibration", "Calibration", None),
+    "gyrocal.thermal": ("gyrocal.thermal.model", "ThermalCalibration", None),
+    "gyrocal.simulation-truth": ("gyrocal.simulation.truth", "SimulationTruth", None),
+    "gyrocal.noise": ("gyrocal.noise.report", "NoiseReport", "gyrocal.noise_file"),
+    "gyrocal.thermal-bias": ("gyrocal.flight.thermal_bias", "ThermalBias", "gyrocal.thermal_bias_file"),
+    "gyrocal.verify": ("gyrocal.verify.report", "VerifyReport", None),
 }
-
-_KINDS: dict[str, type] = {}
+#: Kinds added at run time with :func:`register`: format -> class (its own methods make its documents).
+_REGISTERED: dict[str, type] = {}
 T = TypeVar("T")
 
 
@@ -60,27 +59,47 @@ def register(cls: type[T]) -> type[T]:
     for name in ("to_document", "from_document"):
         if not callable(getattr(cls, name, None)):
             raise InputError(f"{cls.__name__} needs a {name} method to be a file kind")
-    known = _KINDS.get(fmt)
+    known = _REGISTERED.get(fmt) or (_class(fmt) if fmt in KINDS else None)
     if known is not None and known.__qualname__ != cls.__qualname__:
         raise InputError(f"format {fmt!r} is already registered to {known.__name__}")
-    _KINDS[fmt] = cls
+    _REGISTERED[fmt] = cls
     return cls
 
 
+def _class(fmt: str) -> type:
+    module, name, _ = KINDS[fmt]
+    return getattr(importlib.import_module(module), name)
+
+
+def _codec(fmt: str):
+    """What makes and reads documents of `fmt`: its document module, or the class itself."""
+    if fmt in _REGISTERED:
+        return _REGISTERED[fmt]
+    codec = KINDS[fmt][2]
+    return _class(fmt) if codec is None else importlib.import_module(codec)
+
+
 def kinds() -> dict[str, type]:
-    """Every known format and its kind (importing the modules of :data:`KIND_MODULES`)."""
-    for module in KIND_MODULES.values():
-        importlib.import_module(module)
-    return dict(_KINDS)
+    """Every known format and its kind."""
+    return {**{fmt: _class(fmt) for fmt in KINDS}, **_REGISTERED}
 
 
 def _kind(fmt: Any, path) -> type:
-    if isinstance(fmt, str) and fmt not in _KINDS and fmt in KIND_MODULES:
-        importlib.import_module(KIND_MODULES[fmt])
-    if isinstance(fmt, str) and fmt in _KINDS:
-        return _KINDS[fmt]
+    if isinstance(fmt, str) and fmt in _REGISTERED:
+        return _REGISTERED[fmt]
+    if isinstance(fmt, str) and fmt in KINDS:
+        return _class(fmt)
     known = ", ".join(sorted(kinds()))
     raise FileFormatError(f"{path}: field 'format' is {fmt!r}; gyrocal reads {known}", "format")
+
+
+def to_document(obj: Any) -> dict:
+    """The JSON-ready document of a file kind's object."""
+    fmt = getattr(type(obj), "FORMAT", None)
+    if not isinstance(fmt, str) or fmt not in KINDS and fmt not in _REGISTERED or not isinstance(obj, _kind(fmt, "")):
+        raise InputError(f"{type(obj).__name__} is not a registered gyrocal file kind; it cannot be saved")
+    codec = _codec(fmt)
+    return obj.to_document() if isinstance(codec, type) else codec.to_document(obj)
 
 
 def from_document(doc: Any, path: Any = "document", kind: type | tuple[type, ...] | None = None) -> Any:
@@ -98,7 +117,8 @@ def from_document(doc: Any, path: Any = "document", kind: type | tuple[type, ...
         wanted = kind if isinstance(kind, tuple) else (kind,)
         names = " or ".join(repr(getattr(k, "FORMAT", k.__name__)) for k in wanted)
         raise FileFormatError(f"{path}: field 'format' is {cls.FORMAT!r}; expected {names}", "format")
-    return cls.from_document(upgrade(doc, path), path)
+    codec = _codec(cls.FORMAT)
+    return codec.from_document(upgrade(doc, path), path)
 
 
 def load(path: str | os.PathLike, kind: type | tuple[type, ...] | None = None) -> Any:
@@ -121,13 +141,8 @@ def load(path: str | os.PathLike, kind: type | tuple[type, ...] | None = None) -
 
 
 def save(obj: Any, path: str | os.PathLike) -> None:
-    """Write ``obj.to_document()`` to `path` as JSON, atomically."""
-    fmt = getattr(type(obj), "FORMAT", None)
-    if isinstance(fmt, str) and fmt not in _KINDS and fmt in KIND_MODULES:
-        importlib.import_module(KIND_MODULES[fmt])  # a kind whose file code registers it from another module
-    if fmt not in _KINDS or not isinstance(obj, _KINDS[fmt]):
-        raise InputError(f"{type(obj).__name__} is not a registered gyrocal file kind; it cannot be saved")
-    write_json(path, obj.to_document())
+    """Write the document of `obj` (:func:`to_document`) to `path` as JSON, atomically."""
+    write_json(path, to_document(obj))
 
 
 def load_calibration(path: str | os.PathLike):

@@ -40,7 +40,7 @@ import numpy as np
 from ._jsonfile import check_header, get, read_json
 from ._version import __version__
 from .errors import FileFormatError, InputError
-from .files import load, register, save
+from .files import load, save
 from .noise.allan import ONE_SIGMA
 from .noise.figures import ROWS, Figure
 from .noise.report import FORMAT, VERSION, NoiseReport, SensorKind, SensorNoise
@@ -204,7 +204,6 @@ def upgrade_v1(doc: dict, path="file") -> dict:
 _DEG_SUFFIXES = ("deg/s/rthz", "deg/s/sqrt(hz)", "dps/rthz", "deg/s/√hz")
 
 
-register(NoiseReport)
 
 
 def save_noise(path: str | os.PathLike, report: NoiseReport) -> None:

@@ -34,7 +34,7 @@ import numpy as np
 from ._jsonfile import check_header, get, get_array
 from ._version import __version__
 from .errors import FileFormatError, InputError
-from .files import load, register, save
+from .files import load, save
 from .flight.thermal_bias import MAX_ORDER, AccelDrift, ThermalBias
 
 __all__ = ["FORMAT", "VERSION", "from_document", "load_thermal_bias", "save_thermal_bias", "to_document"]
@@ -127,7 +127,6 @@ def from_document(doc: dict, path="file") -> ThermalBias:
         raise FileFormatError(f"{path}: {exc}") from None
 
 
-register(ThermalBias)
 
 
 def save_thermal_bias(tb: ThermalBias, path: str | os.PathLike) -> None:

@@ -99,6 +99,7 @@ def thermal_bias(
 ) -> None:
     """Fit gyro bias (and accelerometer offset change) against temperature for PX4 and ArduPilot (export with
     --format px4 or ardupilot)."""
+    from ..files import to_document
     from ..flight import ThermalBias, fit_thermal_bias
 
     check_output(output, inputs=(log,), force=force, replaceable=json_format(ThermalBias.FORMAT))
@@ -115,7 +116,7 @@ def thermal_bias(
         source["accel_units"] = rec.accel_source_units
     tb = fit_thermal_bias(rec.gyro, rec.temp, fs, max_order=max_order, min_span=min_span, source=source,
                           accel=rec.accel)
-    doc = judge_plausible(tb.to_document(), _implausible(tb, rec, log, fs), accept_implausible)
+    doc = judge_plausible(to_document(tb), _implausible(tb, rec, log, fs), accept_implausible)
     doc, verdict = finish(doc, flags, inputs=(log,), device_id=source.get("device_id"))
     record = write_and_store(doc, flags, output, verdict, inputs=(log,), kind="thermal-bias", job="thermal-bias")
     _print(tb, rec, output_units, gravity, fs)

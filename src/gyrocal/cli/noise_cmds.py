@@ -101,6 +101,7 @@ def noise(
     flags: StationFlags = StationFlags(),
 ) -> None:
     """Allan deviation of a log at rest: noise density, bias instability and random walk, with intervals."""
+    from ..files import to_document
     from ..noise import FORMAT, characterise_recording
     from ..units import parse_rate_unit, unit_factor
 
@@ -124,7 +125,7 @@ def noise(
         raise InputError("noise figures are physical quantities, so raw accelerometer counts need their sensitivity",
                          param="accel_sensitivity", hint="give {param} (LSB per g, e.g. 16384 for +-2 g)")
     report = characterise_recording(rec, motion=motion, source={"file": recording.name})
-    doc, verdict = finish(report.to_document(), flags, inputs=(recording,))
+    doc, verdict = finish(to_document(report), flags, inputs=(recording,))
     record = write_and_store(doc, flags, json_out, verdict, inputs=(recording,), kind="noise", job="noise")
     shown = parse_rate_unit(output_units or "deg/s") if unit == "counts" else unit
     fs = report.sample_rate

@@ -93,19 +93,6 @@ class ThermalBias(TemperaturePolynomial):
     FORMAT: ClassVar[str] = "gyrocal.thermal-bias"
     VERSION: ClassVar[int] = 2
 
-    def to_document(self) -> dict:
-        """The JSON-ready document (``format: gyrocal.thermal-bias``)."""
-        from ..thermal_bias_file import to_document
-
-        return to_document(self)
-
-    @classmethod
-    def from_document(cls, doc: dict, path="document") -> ThermalBias:
-        """Validate a document and rebuild the fit, naming any bad field."""
-        from ..thermal_bias_file import from_document
-
-        return from_document(doc, path)
-
     def __post_init__(self):
         check_curve(self)
         if self.accel is not None and not isinstance(self.accel, AccelDrift):

@@ -1,8 +1,8 @@
 """The noise report of a log at rest: each sensor's Allan deviation and figures, and where they came from.
 
 The report's file, ``format: gyrocal.noise``, is read and written by :mod:`gyrocal.noise_file`
-(core numerics do not hold file code); the report delegates its ``to_document`` and
-``from_document`` to it, so :func:`gyrocal.files.load` and ``save`` handle it like any kind.
+(core numerics do not hold file code); :mod:`gyrocal.files` knows it by name, so ``load``,
+``save`` and ``to_document`` handle it like any kind.
 """
 
 from __future__ import annotations
@@ -117,19 +117,6 @@ class NoiseReport:
 
     FORMAT: ClassVar[str] = FORMAT
     VERSION: ClassVar[int] = VERSION
-
-    def to_document(self) -> dict:
-        """The JSON-ready document (``format: gyrocal.noise``; the file code is :mod:`gyrocal.noise_file`)."""
-        from ..noise_file import to_document
-
-        return to_document(self)
-
-    @classmethod
-    def from_document(cls, doc: dict, path="document") -> NoiseReport:
-        """Validate a current-version document (older ones come upgraded by :mod:`gyrocal.legacy`)."""
-        from ..noise_file import from_document
-
-        return from_document(doc, path)
 
     @property
     def duration(self) -> float:

@@ -27,7 +27,6 @@ from typing import Any, ClassVar
 from .._jsonfile import check_header, get, get_array
 from .._version import __version__
 from ..errors import FileFormatError, InputError, NonPhysicalEstimateError
-from ..files import register
 from ..models import Affine, CalibrationModel, ScaleBias
 
 __all__ = ["SimulationTruth", "servo_facts", "truth_path"]
@@ -48,7 +47,6 @@ def servo_facts(truth) -> dict[str, Any]:
             "plateaus": [w.to_dict() for w in truth.plateaus]}
 
 
-@register
 @dataclass(frozen=True)
 class SimulationTruth:
     """What a simulated recording really holds.

@@ -38,7 +38,6 @@ from .._validation import at_least, finite_array, refuse_options, temperature
 from .._version import __version__
 from ..choices import OutOfRange, TableModel, values
 from ..errors import FileFormatError, InputError, UnitError
-from ..files import register
 from ..models import KG_NAMES, kg_to_kb
 from ..recording import Recording
 from ..sections import FitQuality, section
@@ -69,7 +68,6 @@ def _solve3(K: np.ndarray, y: np.ndarray) -> np.ndarray:
     return (c12 * y[:, :1] + c20 * y[:, 1:2] + c01 * y[:, 2:]) / det[:, None]
 
 
-@register
 @dataclass(frozen=True)
 class ThermalCalibration:
     """A gyro calibrated at several temperatures (the full-temperature-range method).

@@ -32,7 +32,6 @@ import numpy as np
 from .._jsonfile import check_header, get, get_array
 from .._version import __version__
 from ..errors import FileFormatError
-from ..files import register
 from ..units import RateUnit, parse_rate_unit, unit_factor
 from .alignment import Alignment
 from .metrics import FIGURES, Metrics
@@ -45,7 +44,6 @@ AXES = ("x", "y", "z")
 COVARIANCE_ORDER = ("time_offset_s", "clock_drift_ppm", "phi_x_rad", "phi_y_rad", "phi_z_rad")
 
 
-@register
 @dataclass(frozen=True)
 class VerifyReport:
     """A calibration checked against a reference gyro.
