@@ -178,3 +178,73 @@ def test_the_command_line_starts_without_numpy():
             "'pydantic') if m in sys.modules); print(','.join(heavy))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True)
     assert out.stdout.strip() == ""
+
+
+def _import_graph(sources) -> dict[str, set[str]]:
+    """gyrocal module -> the gyrocal modules it imports anywhere (module level or inside a function)."""
+    names = {_module_name(p) for p in sources}
+    graph: dict[str, set[str]] = {}
+    for path in sources:
+        me = _module_name(path)
+        found = set()
+        for module, _, _, _ in _imports(path):
+            while module and module not in names:  # "from gyrocal.x import name": the module that holds it
+                module = module.rpartition(".")[0]
+            if module and module != me:
+                found.add(module)
+        graph[me] = found
+    return graph
+
+
+def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Strongly connected groups of more than one module (Tarjan's algorithm, iterative)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    groups = []
+    for root in graph:
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph[root])))]
+        index[root] = low[root] = len(index)
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, children = work[-1]
+            child = next(children, None)
+            if child is not None:
+                if child not in index:
+                    index[child] = low[child] = len(index)
+                    stack.append(child)
+                    on_stack.add(child)
+                    work.append((child, iter(sorted(graph.get(child, ())))))
+                elif child in on_stack:
+                    low[node] = min(low[node], index[child])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[node])
+            if low[node] == index[node]:
+                group = []
+                while True:
+                    member = stack.pop()
+                    on_stack.discard(member)
+                    group.append(member)
+                    if member == node:
+                        break
+                if len(group) > 1:
+                    groups.append(sorted(group))
+    return groups
+
+
+def test_no_import_cycle_even_inside_functions():
+    """Reference: the import statements themselves (ast), module level and inside functions alike; a package's
+    __init__ importing its own modules is not a cycle unless a module imports the package back."""
+    assert _cycles(_import_graph(SOURCES)) == []
+
+
+def test_the_cycle_check_finds_one():
+    """A ring of three modules is found, and a module outside it is not."""
+    graph = {"gyrocal.a": {"gyrocal.b"}, "gyrocal.b": {"gyrocal.c"}, "gyrocal.c": {"gyrocal.a"}, "gyrocal.d": {"gyrocal.a"}}
+    assert _cycles(graph) == [["gyrocal.a", "gyrocal.b", "gyrocal.c"]]
