@@ -40,7 +40,7 @@ for _core in ("models", "observations", "estimators", "design", "segmentation", 
 #: Modules of gyrocal.cli that hold commands; each may import none of the others.
 CMDS_SUFFIX = "_cmds"
 #: Module-level imports a command module may make: ``gyrocal --help`` must not load numpy.
-LIGHT_FOR_CLI = ("gyrocal.choices", "gyrocal.errors", "gyrocal.export", "gyrocal.cli", "typer")
+LIGHT_FOR_CLI = ("gyrocal.choices", "gyrocal.constants", "gyrocal.errors", "gyrocal.export", "gyrocal.cli", "typer")
 
 
 def _module_name(path: Path) -> str:

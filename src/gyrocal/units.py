@@ -12,6 +12,7 @@ from typing import get_args
 import numpy as np
 
 from .choices import InputUnit, RateUnit
+from .constants import MAD_TO_SIGMA, STANDARD_GRAVITY  # noqa: F401  (defined once, numpy-free)
 from .errors import UnitError
 
 __all__ = ["RateUnit", "InputUnit", "accel_scale", "RATE_UNITS", "parse_rate_unit", "parse_input_unit", "to_rad_s", "from_rad_s", "unit_factor",
@@ -19,8 +20,6 @@ __all__ = ["RateUnit", "InputUnit", "accel_scale", "RATE_UNITS", "parse_rate_uni
 
 
 RATE_UNITS: tuple[str, ...] = get_args(RateUnit)
-STANDARD_GRAVITY = 9.80665  # m/s^2, the standard acceleration of gravity (3rd CGPM, 1901)
-MAD_TO_SIGMA = 1.482602218505602  # median absolute deviation -> sigma of a Gaussian: 1 / Phi^-1(3/4)
 
 _FACTOR_TO_RAD_S = {"rad/s": 1.0, "deg/s": math.pi / 180.0}
 _ALIASES = {

@@ -16,11 +16,11 @@ from typing import Annotated, Optional
 import typer
 
 from ..choices import SaturationPolicy
+from ..constants import STANDARD_GRAVITY
 from ..errors import GyrocalError, InputError
 
 __all__ = ["READING", "ReadingFlags", "prefixed_params", "read_from_flags", "required_units"]
 
-STANDARD_GRAVITY = 9.80665  # m/s^2; the library's default (gyrocal.io._build.STANDARD_GRAVITY)
 
 
 class ReadingFlags:

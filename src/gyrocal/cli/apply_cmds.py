@@ -8,6 +8,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..choices import OutOfRange, TableModel
+from ..constants import STANDARD_GRAVITY
 from ..errors import InputError
 from ._options import given, iso_time
 from ._outputs import check_output, refuse_swapped, starts_with
@@ -38,7 +39,7 @@ def apply(
     imu: READING.Imu = None,
     accel_units: READING.AccelUnits = None,
     accel_sensitivity: READING.AccelSensitivity = None,
-    gravity: READING.Gravity = 9.80665,
+    gravity: READING.Gravity = STANDARD_GRAVITY,
     model: Annotated[TableModel, typer.Option("--model", help="Thermal files: evaluation in temperature.")]
     = "lagrange",
     out_of_range: Annotated[OutOfRange, typer.Option(

@@ -9,6 +9,7 @@ from typing import Annotated, Optional
 
 import typer
 
+from ..constants import STANDARD_GRAVITY
 from ._options import AcceptImplausible, judge_plausible
 from ._outputs import check_output, json_format
 from ._reading import READING, read_from_flags, required_units
@@ -91,7 +92,7 @@ def thermal_bias(
         "its columns, m/s^2 or g (counts with --accel-sensitivity; flight logs: m/s^2) (default: gyro only).",
         metavar="<m/s^2|g|counts>")] = None,
     accel_sensitivity: READING.AccelSensitivity = None,
-    gravity: READING.Gravity = 9.80665,
+    gravity: READING.Gravity = STANDARD_GRAVITY,
     force: Annotated[bool, typer.Option("--force", help="Replace an -o file that is not a thermal-bias file.")]
     = False,
     accept_implausible: AcceptImplausible = False,

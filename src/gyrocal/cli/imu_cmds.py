@@ -8,6 +8,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..choices import AccelModel, AccelOutputUnit, ImuGyroModel
+from ..constants import STANDARD_GRAVITY
 from ._imu_report import print_imu_run
 from ._options import AcceptImplausible, judge_plausible
 from ._outputs import check_output, same_document
@@ -34,7 +35,7 @@ def imu(
     imu: READING.Imu = None,
     accel_units: READING.AccelUnits = None,
     accel_sensitivity: READING.AccelSensitivity = None,
-    gravity: READING.Gravity = 9.80665,
+    gravity: READING.Gravity = STANDARD_GRAVITY,
     accel_log: Annotated[Optional[Path], typer.Option(
         "--accel-log", help="The accelerometer's own log, when it is not in the gyro's (imu_tk keeps the two apart) "
         "(default: none, ax ay az are in the recording).")] = None,

@@ -9,6 +9,7 @@ from typing import Annotated, Optional
 import typer
 
 from ..choices import MotionPolicy
+from ..constants import STANDARD_GRAVITY
 from ..errors import InputError
 from ._outputs import check_output, json_format
 from ._reading import READING, read_from_flags, required_units
@@ -88,7 +89,7 @@ def noise(
     no_unit_check: READING.NoUnitCheck = False,
     accel_units: READING.AccelUnits = None,
     accel_sensitivity: READING.AccelSensitivity = None,
-    gravity: READING.Gravity = 9.80665,
+    gravity: READING.Gravity = STANDARD_GRAVITY,
     imu: READING.Imu = None,
     motion: Annotated[MotionPolicy, typer.Option(
         "--motion", help="A log that moves: analyse its longest still stretch (restrict) or refuse it.")] = "restrict",

@@ -323,6 +323,7 @@ def _servo(protocol, model, gyro_kw, turns, speed, wait, ramp, vibration, misali
 
 def _static(gyro_kw, flags: dict, sample_rate, rng, settings):
     """``--protocol static``: a board lying still, warming up when --temp-start and --temp-end differ."""
+    from ..constants import STANDARD_GRAVITY
     from ..models import ScaleBias
     from ..simulation import BiasDrift, StillAccelerometer, StillProtocol, VirtualGyro, simulate_still
 
@@ -349,6 +350,6 @@ def _static(gyro_kw, flags: dict, sample_rate, rng, settings):
                                        "equation": "bias(T) = sum_n coefs[:, n] (T - 25)^n [rad/s]"},
                        "accelerometer": None if accel is None else {
                            "noise_density": accel.noise_density, "random_walk": accel.random_walk,
-                           "gravity": [0.0, 0.0, 9.80665]}}}
+                           "gravity": [0.0, 0.0, STANDARD_GRAVITY]}}}
     return rec, facts
 

@@ -9,6 +9,7 @@ import numpy as np
 from .._validation import positive
 from ..breaks import BREAK_S, counter_breaks, find_counter, join_backward_parts
 from ..choices import AccelUnit, SaturationPolicy, values
+from ..constants import STANDARD_GRAVITY
 from ..errors import InputError, NonFiniteInputError, SaturationError, UnitError
 from ..recording import Recording
 from ..saturation import find_saturation, stuck_runs
@@ -180,7 +181,6 @@ def _rates_block(gx, gy, gz) -> np.ndarray:
 
 
 #: Standard gravity [m/s^2], the default value of one g.
-STANDARD_GRAVITY = 9.80665
 
 
 def _accel_fields(data: dict, source: str, accel_units: str | None, accel_sensitivity: float | None,

@@ -14,6 +14,7 @@ import os
 
 import numpy as np
 
+from ..constants import STANDARD_GRAVITY
 from ..errors import InputError
 from ..recording import Recording
 from ._columns import parse_columns
@@ -39,7 +40,7 @@ def _gyro_style_columns(columns) -> dict[str, str]:
 
 def attach_accelerometer(rec: Recording, path: str | os.PathLike, *, accel_units: str, columns=None,
                          skip_rows: int | None = None, sample_rate: float | None = None,
-                         accel_sensitivity: float | None = None, gravity: float = 9.80665) -> Recording:
+                         accel_sensitivity: float | None = None, gravity: float = STANDARD_GRAVITY) -> Recording:
     """`rec` with the accelerometer of the log at `path` (and, when the logs' times differ, only their overlap).
 
     Parameters
