@@ -96,7 +96,8 @@ def noise(
     plot: Annotated[Optional[Path], typer.Option(
         "--plot", help="Allan deviation plot (.png, .pdf, .svg) (default: none).")] = None,
     json_out: Annotated[Optional[Path], typer.Option(
-        "--json", help="Write the noise file, gyrocal.noise (default: none).")] = None,
+        "-o", "--output", "--json", help="Write the noise file, gyrocal.noise (default: none); --json is its old "
+        "name.")] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace a --json file that is not a noise file.")]
     = False,
     flags: StationFlags = StationFlags(),
@@ -107,7 +108,7 @@ def noise(
     from ..units import parse_rate_unit, unit_factor
 
     # every output is checked before anything is read, computed or written
-    check_output(json_out, flag="--json", inputs=(recording,), force=force, replaceable=json_format(FORMAT))
+    check_output(json_out, flag="-o", inputs=(recording,), force=force, replaceable=json_format(FORMAT))
     check_output(plot, flag="--plot", inputs=(recording, json_out), outputs=(json_out,), force=True)
     if plot is not None:
         from ..plotting import check_figure_path

@@ -19,7 +19,7 @@ from .identity import check_serial
 __all__ = ["IDENTITY_COLUMNS", "JOBS", "Row", "read_manifest"]
 
 #: Job -> the flag its result file is written with.
-JOBS = {"calibrate": "-o", "imu": "-o", "thermal": "-o", "thermal-bias": "-o", "noise": "--json"}
+JOBS = {"calibrate": "-o", "imu": "-o", "thermal": "-o", "thermal-bias": "-o", "noise": "-o"}
 REQUIRED = ("file", "serial", "job", "args")
 IDENTITY_COLUMNS = ("part", "revision", "station", "operator", "fixture", "procedure")
 # flags the batch sets itself: a row's args must not set them too
