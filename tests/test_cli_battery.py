@@ -141,7 +141,7 @@ CASES = [
     ("calibrate {rec.csv} --units deg/s --speed nan", 2, "--speed must be a positive number"),
     ("calibrate {rec.csv} --units deg/s --angle 0", 2, "--angle must be a positive number"),
     ("calibrate {rec.csv} --units deg/s --speed 60 --angle 360", 2, "not both"),
-    ("calibrate {rec.csv} --units deg/s --speed abc", 2, r"--speed: 'abc' is not a number"),
+    ("calibrate {rec.csv} --units deg/s --speed abc", 2, r"--speed must be a number, with a unit if you like"),
     ("calibrate {rec.csv} --units deg/s --sample-rate 0", 2, "--sample-rate must be finite and > 0"),
     ("calibrate {rec.csv} --units deg/s --sample-rate -200", 2, "--sample-rate must be finite and > 0"),
     ("calibrate {notime.csv} --units deg/s --speed 60", 2, r"--sample-rate HZ.*--columns t=NAME"),

@@ -188,8 +188,8 @@ def test_command_list_starts_with_calibrate_and_keeps_every_description_whole():
     (("calibrate", "x.csv", "--method", "foo"),
      "error: invalid value for --method: 'foo' is not one of 'first-moment', 'algorithm1', 'lm' "
      "(see 'gyrocal calibrate --help')"),
-    (("calibrate", "x.csv", "--speed", "fast"),
-     "error: invalid value for --speed: 'fast' is not a number (see 'gyrocal calibrate --help')"),
+    (("calibrate", "x.csv", "--angle", "fast"),
+     "error: invalid value for --angle: 'fast' is not a number (see 'gyrocal calibrate --help')"),
     (("apply", "cal.json", "rec.csv"), "error: missing option '-o' / '--output' (see 'gyrocal apply --help')"),
     (("segments",), "error: missing argument 'recording' (see 'gyrocal segments --help')"),
     (("calibrat",), "error: no such command 'calibrat'"),

@@ -18,7 +18,7 @@ import typer
 
 from ..choices import Method
 from ..errors import GyrocalError, InputError
-from ._options import AcceptImplausible, judge_plausible
+from ._options import AcceptImplausible, in_unit, judge_plausible
 from ._outputs import check_output, same_document
 from ._reading import READING, read_from_flags, required_units
 from ._references import density_to_internal, noise_to_internal, rate_unit_of, reference_of
@@ -35,9 +35,9 @@ EXAMPLE_SPEED = 60.0  # deg/s, the servo protocol of Wang et al.
 WindowsFile = Annotated[Optional[Path], typer.Option(
     "--windows", help="Windows file (JSON/CSV list, or imucal's section list) that replaces detection "
     "(default: detected).")]
-Speed = Annotated[Optional[float], typer.Option(
-    "--speed", help="Known constant turn rate, in the data's rate unit (deg/s with --units deg/s; --output-units "
-    "for counts) (default: none, --angle 360).")]
+Speed = Annotated[Optional[str], typer.Option(
+    "--speed", help="Known constant turn rate: a number in the data's rate unit (deg/s with --units deg/s; "
+    "--output-units for counts), or with its unit, e.g. 60deg/s or 1.05rad/s (default: none, --angle 360).")]
 Angle = Annotated[Optional[float], typer.Option(
     "--angle", help="Known angle of each turn, in degrees; the speed may vary (default: 360 unless --speed).")]
 AngleSd = Annotated[Optional[float], typer.Option(
@@ -51,6 +51,17 @@ PlotPath = Annotated[Optional[Path], typer.Option(
 Output = Annotated[Optional[Path], typer.Option(
     "-o", "--output", help="Calibration file to write (default: none; the parameters are printed).")]
 Force = Annotated[bool, typer.Option("--force", help="Replace an output that holds a different calibration.")]
+
+
+def _speed(text: str | None, rate_unit: str) -> float | None:
+    """--speed as a number in the data's rate unit: a bare number is in it (its range is checked later), and
+    one written with its unit (60deg/s, 1.05rad/s) is converted."""
+    if text is None:
+        return None
+    try:
+        return float(text)
+    except ValueError:
+        return in_unit("--speed", text, rate_unit)
 
 
 def _windows_from_file(path: Optional[Path], rec):
@@ -219,6 +230,7 @@ def calibrate(
         raise InputError("give a recording to calibrate (or --example for the bundled one)")
     units, read_notes = required_units(units), []
     rate_unit = rate_unit_of(units, output_units)
+    speed = _speed(speed, rate_unit)
     reference, speed_rad, angle_rad, ref_sd = reference_of(speed, angle, rate_unit, speed_sd=speed_sd,
                                                            angle_sd=angle_sd)
     if ref_sd is not None and method != "first-moment":
@@ -294,6 +306,7 @@ def segments(
 
     units = required_units(units)
     rate_unit = rate_unit_of(units, output_units)
+    speed = _speed(speed, rate_unit)
     reference, speed_rad, angle_rad, _ = reference_of(speed, angle, rate_unit)
     check_output(plot, flag="--plot", inputs=(recording, windows), force=True)
     rec = read_from_flags(recording, units=units, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
