@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import GyrocalError, InputError
-from .app import console
+from .app import console, message
 
 
 @dataclass(frozen=True)
@@ -29,7 +29,7 @@ class WriteBack:
             request = request_for(cal)
             answer = write_back(self.link, request, self.timeout)
         except GyrocalError as exc:
-            return {**doc, "device": {**device, "written_back": False, "refusal": str(exc)}}, exc
+            return {**doc, "device": {**device, "written_back": False, "refusal": message(exc)}}, exc
         serial = (doc.get("unit") or {}).get("serial")
         console.print(f"{serial + ': ' if serial else ''}written to the device and read back", highlight=False)
         device.update(written_back=True, request=answer.seq, rate_unit=answer.rate_unit,
