@@ -154,6 +154,12 @@ static void test_set_calibration_round_trip(void)
         CHECK(i + 1u == n || type == 0u);
     }
     CHECK(seen == 0u && type == GYROCAL_FRAME_SET_CALIBRATION);
+    /* a false start whose length byte is the real frame's sync: the receiver finds that sync again */
+    seen = gyrocal_frame_rx_byte(&rx, 0xA5u) | gyrocal_frame_rx_byte(&rx, 0x5Au) | gyrocal_frame_rx_byte(&rx, 7u);
+    for (i = 0; i < n; ++i) {
+        type = gyrocal_frame_rx_byte(&rx, out[i]);
+    }
+    CHECK(seen == 0u && type == GYROCAL_FRAME_SET_CALIBRATION);
     CHECK(gyrocal_parse_set_calibration(rx.buf + 4, rx.buf[3], &got) == GYROCAL_OK);
     CHECK(memcmp(&got.cal, &set.cal, sizeof set.cal) == 0 && got.seq == 7u && got.flags == set.flags);
     /* the echo is the request with another type and its status byte */

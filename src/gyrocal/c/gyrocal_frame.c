@@ -299,6 +299,24 @@ void gyrocal_frame_rx_reset(gyrocal_frame_rx_t *rx)
     }
 }
 
+/* The bytes held did not make a frame (a length too large, a CRC that does not match): keep them from the next sync
+ * on, as the host's decoder does, so a false start does not swallow the frame that follows it. */
+static void rx_resync(gyrocal_frame_rx_t *rx)
+{
+    uint8_t i, j;
+    do {
+        for (i = 1u; i < rx->len; ++i) {
+            if (rx->buf[i] == GYROCAL_FRAME_SYNC0 && (i + 1u == rx->len || rx->buf[i + 1u] == GYROCAL_FRAME_SYNC1)) {
+                break;
+            }
+        }
+        for (j = 0u; i < rx->len; ++i, ++j) {
+            rx->buf[j] = rx->buf[i];
+        }
+        rx->len = j;
+    } while (rx->len >= 4u && rx->buf[3] > GYROCAL_FRAME_MAX_PAYLOAD);
+}
+
 unsigned gyrocal_frame_rx_byte(gyrocal_frame_rx_t *rx, uint8_t byte)
 {
     size_t n;
@@ -316,17 +334,18 @@ unsigned gyrocal_frame_rx_byte(gyrocal_frame_rx_t *rx, uint8_t byte)
     }
     rx->buf[rx->len++] = byte;
     if (rx->len == 4u && rx->buf[3] > GYROCAL_FRAME_MAX_PAYLOAD) {
-        rx->len = 0u;
+        rx_resync(rx);
         return 0u;
     }
     n = rx->len < 4u ? GYROCAL_FRAME_MAX : (size_t)rx->buf[3] + GYROCAL_FRAME_OVERHEAD;
     if (rx->len < n) {
         return 0u;
     }
-    rx->len = 0u;
     crc = gyrocal_crc16(rx->buf + 2, n - 4u, 0xFFFFu);
     if (rx->buf[n - 2u] != (crc & 0xFFu) || rx->buf[n - 1u] != (crc >> 8)) {
+        rx_resync(rx);
         return 0u;
     }
+    rx->len = 0u;
     return rx->buf[2];
 }

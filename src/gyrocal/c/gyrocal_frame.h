@@ -153,7 +153,8 @@ gyrocal_status_t gyrocal_parse_set_calibration(const uint8_t *payload, size_t le
 
 void gyrocal_frame_rx_reset(gyrocal_frame_rx_t *rx);
 /* Take one byte; returns the type of the frame it completes when its CRC is good (its payload at rx->buf + 4,
- * rx->buf[3] bytes, valid until the next call), else 0. A bad frame is dropped and the search starts again. */
+ * rx->buf[3] bytes, valid until the next call), else 0. Bytes that make no frame (a length too large, a bad CRC)
+ * are dropped up to the next sync among them, so the search goes on from there. */
 unsigned gyrocal_frame_rx_byte(gyrocal_frame_rx_t *rx, uint8_t byte);
 
 #ifdef __cplusplus

@@ -149,6 +149,14 @@ class CDevice:
     def text(self, text: str) -> bytes:
         return self._out(self.dll.gyrocal_frame_text(self._buf, text.encode()))
 
+    def set_calibration(self, seq: int, flags: int, rate_unit: int, matrix, offset, status: int | None = None) -> bytes:
+        """A set-calibration frame (`status` None), or with a status the calibration-stored frame echoing it."""
+        c = _SetCal(seq & 0xFFFFFFFF, flags, rate_unit, (_F3 * 3)(*(_F3(*row) for row in np.reshape(matrix, (3, 3)))),
+                    _F3(*offset))
+        if status is None:
+            return self._out(self.dll.gyrocal_frame_set_calibration(self._buf, ctypes.byref(c)))
+        return self._out(self.dll.gyrocal_frame_calibration_stored(self._buf, status, ctypes.byref(c)))
+
     def _events(self, s: _Session, events: int) -> bytes:
         out = b""
         if events & 1:
