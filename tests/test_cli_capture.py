@@ -340,6 +340,7 @@ def test_write_back_after_a_pass_is_stored_and_read_back_by_the_device(tmp_path,
     assert "SN-7: written to the device and read back" in stdout and stdout.rstrip().endswith("SN-7: PASS")
     sent = np.asarray(doc["correction"]["matrix"], dtype=np.float32)
     device = doc["device"]
+    assert doc["units"]["output"] == "deg/s" and device["rate_unit"] == "deg/s"  # the hello's unit, as the file
     assert device["written_back"] is True and device["applied"] is True
     np.testing.assert_array_equal(np.asarray(device["matrix"], np.float32), sent)
     (page,) = fr.FrameDecoder().feed(storage.page)

@@ -18,14 +18,19 @@ from .write_frames import CalibrationStored, SetCalibration
 __all__ = ["request_for", "write_back"]
 
 
-def request_for(cal) -> SetCalibration:
-    """The request carrying `cal`'s correction in the device's raw units (counts in, its rate unit out)."""
-    if cal.input_units != "counts":
-        raise InputError(f"--write-back sends a correction of raw counts; this calibration reads {cal.input_units}",
+def request_for(cal, rate_unit: str) -> SetCalibration:
+    """The request carrying `cal`'s correction in the device's raw units: counts in, its `rate_unit` out (the
+    unit its hello frame gives, so that its corrected samples keep their unit)."""
+    if cal.input_units != "counts" or cal.sensitivity is None:
+        raise InputError("--write-back sends a correction of raw counts; this calibration reads "
+                         f"{cal.input_units}{'' if cal.sensitivity else ' without a sensitivity'}",
                          hint="capture with --units counts (gyrocal frames always send counts)")
+    from ..units import unit_factor
+
     matrix, offset = cal.correction
+    matrix = matrix * (unit_factor(cal.output_units) / unit_factor(rate_unit))
     seq = int.from_bytes(os.urandom(4), "little")  # a fresh number: an old answer still in flight cannot match
-    return SetCalibration.of(seq, matrix, offset, cal.output_units)
+    return SetCalibration.of(seq, matrix, offset, rate_unit)
 
 
 def write_back(link, request: SetCalibration, timeout: float) -> CalibrationStored:

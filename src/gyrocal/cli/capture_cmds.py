@@ -236,7 +236,7 @@ def _one_unit(output: Path, calibration: Path | None, flags: StationFlags, *, po
     try:
         from ._write_back import WriteBack
 
-        send = None if write_back is None else WriteBack(cap.link, result.wire, write_back)
+        send = None if write_back is None else WriteBack(cap.link, result.wire, write_back, result.hello)
         return _finish(result, port, reading, guided, cal_path, speed_rad, flags, send)
     finally:
         cap.close()
