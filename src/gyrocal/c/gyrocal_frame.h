@@ -5,7 +5,7 @@
  *
  * C99, no dynamic memory, no static data, nothing from libc. Every encoder writes one whole frame
  * into a caller buffer of GYROCAL_FRAME_MAX bytes and returns its length; a NULL pointer (other than
- * the result's parameters, sent as zeros) writes nothing and returns 0.
+ * the result's parameters and a refusal's stored correction, sent as zeros) writes nothing and returns 0.
  *
  * A frame:  0xA5 0x5A | type (1) | payload length L (1, <= GYROCAL_FRAME_MAX_PAYLOAD) | payload (L) |
  *           CRC-16 (2)
