@@ -180,3 +180,35 @@ def test_six_axis_firmware_sends_the_accelerometer(example):
     np.testing.assert_array_equal([f.accel for f in six], s.accel)
     np.testing.assert_array_equal([f.t_us for f in six], s.t_us)
     assert frames[0].accel_sensitivity == 16384 and frames[-1] == fr.End(len(s))
+
+
+def test_firmware_stores_reads_back_and_applies_a_written_back_calibration(example, session):
+    """The host's set-calibration frame, received from sample 100 on: the firmware stores it (the fake board's RAM
+    page holds the request's own frame), answers with what it read back, which is the request float32 bit for bit,
+    and corrects every later sample with it, its own result coming later notwithstanding; the virtual device's
+    C-driven storage (CStorage) answers the same bytes. References: the request, and w = matrix (raw - offset)
+    recomputed in float64 within float32 rounding."""
+    from gyrocal.capture.c_device import CStorage
+
+    dll, cdev = example
+    dll.example_host_input.argtypes = [ctypes.c_char_p, ctypes.c_size_t, ctypes.c_uint32]
+    dll.example_page.restype = ctypes.c_size_t
+    dll.example_page.argtypes = [ctypes.c_void_p, ctypes.c_size_t]
+    matrix = np.diag(MODEL.k / session.sensitivity) + 1e-4 * np.eye(3)[[1, 2, 0]]
+    request = fr.SetCalibration.of(42, matrix, -np.degrees(MODEL.b) * session.sensitivity)
+    wire = b"\xa5\x00" + fr.encode(request)  # a stray byte first: the receiver finds the frame after it
+    dll.example_host_input(wire, len(wire), 100)
+    try:
+        frames = fr.FrameDecoder().feed(run_example(dll, session))
+    finally:
+        dll.example_host_input(None, 0, 0)
+    page = ctypes.create_string_buffer(256)
+    assert dll.example_page(page, 256) == len(fr.encode(request)) and page.raw[:62] == fr.encode(request)
+    (echo,) = by_type(frames, fr.CalibrationStored)
+    assert echo.echoes(request) and fr.encode(echo) == CStorage(cdev)(wire)
+    cal = by_type(frames, fr.Calibrated)
+    assert [c.seq for c in cal] == list(range(100, len(session))) and len(by_type(frames, fr.Result)) == 1
+    m = np.asarray(request.matrix, float).reshape(3, 3)
+    d = session.raw[100:].astype(float) - np.asarray(request.offset)
+    bound = 4 * np.finfo(np.float32).eps * (np.abs(d) @ np.abs(m).T + np.abs(np.asarray(request.offset)) @ np.abs(m).T)
+    assert np.all(np.abs(np.array([c.w for c in cal]) - d @ m.T) <= bound)

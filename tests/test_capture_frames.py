@@ -1,5 +1,5 @@
-"""gyrocal frames (gyro-only and 6-axis samples, device messages, the end of a session): the C encoder against
-the Python encoder and decoder byte for byte, the CRC, and resynchronisation.
+"""gyrocal frames (gyro-only and 6-axis samples, device messages, the end of a session, the write-back's request and
+answer): the C encoder against the Python encoder and decoder byte for byte, the CRC, and resynchronisation.
 
 Independent references: the CRC-16/CCITT-FALSE check value 0x29B1 of b"123456789" (the
 published parameter catalogue of CRC-16 variants); the values fed to the encoders (what
@@ -46,6 +46,10 @@ def random_frames(rng, n=200):
     out.append(fr.Hello(100.0, 131.0, "deg/s", False, 2, "imu", accel_sensitivity=16384))
     out.append(fr.Text("+x accepted"))
     out.append(fr.End(int(rng.integers(0, 2**32))))
+    matrix, offset = rng.normal(0, 0.01, (3, 3)), rng.normal(0, 300, 3)
+    out.append(fr.SetCalibration.of(int(rng.integers(0, 2**32)), matrix, offset, "deg/s"))
+    sent = fr.SetCalibration.of(7, matrix, offset, "rad/s", flags=0)
+    out.append(fr.CalibrationStored(7, sent.matrix, sent.offset, "rad/s", 0, status=2))
     return out
 
 
@@ -66,6 +70,9 @@ def c_bytes(cdev: CDevice, f) -> bytes:
     if isinstance(f, fr.Hello):
         return cdev.hello(f.sample_rate, f.sensitivity, has_temp=f.has_temp, firmware=f.firmware, library=f.library,
                           accel_sensitivity=f.accel_sensitivity or 0)
+    if isinstance(f, fr.SetCalibration | fr.CalibrationStored):
+        return cdev.set_calibration(f.seq, f.flags, ("rad/s", "deg/s").index(f.rate_unit), f.matrix, f.offset,
+                                    getattr(f, "status", None))
     return cdev.text(f.text)
 
 
@@ -184,3 +191,20 @@ def test_six_axis_frames_with_faults_lose_only_the_frames_hit(rng, kind):
     if kind == "corrupt":  # a flipped sync or length byte hides its frame; a flipped type (0x17, unknown) does not
         hidden = {int(i // size) for i in hit if i % size in (0, 1, 3)}
         assert dec.stats.crc_errors == len(lost - hidden)
+
+
+def test_write_back_request_through_the_c_receiver_and_echo(cdev, rng):
+    """A Python set-calibration request, fed in pieces with noise before it, is received, stored, read back and
+    echoed by the C library (CStorage, the example firmware's calls); a NaN is refused. Reference: the request."""
+    from gyrocal.capture.c_device import CStorage
+
+    storage = CStorage(cdev)
+    sent = fr.SetCalibration.of(0xDEADBEEF, np.eye(3) / 131.0 + rng.normal(0, 1e-4, (3, 3)), rng.normal(0, 50, 3))
+    data = b"\x00\xa5\x5a\x07" + fr.encode(sent)  # a false start (a frame too long), then the request
+    answer = b"".join(storage(data[i:i + 5]) for i in range(0, len(data), 5))
+    (echo,) = fr.FrameDecoder().feed(answer)
+    assert isinstance(echo, fr.CalibrationStored) and echo.echoes(sent) and echo.status_name == "stored"
+    assert storage.page == fr.encode(sent) and storage.applied == (*sent.matrix, *sent.offset)
+    bad = fr.SetCalibration(1, (float("nan"),) + sent.matrix[1:], sent.offset)
+    (refused,) = fr.FrameDecoder().feed(storage(fr.encode(bad)))
+    assert refused.status == 1 and not refused.echoes(bad) and storage.page == fr.encode(sent)

@@ -317,3 +317,70 @@ def test_station_capture_accepts_stores_and_asks_for_the_next_unit(tmp_path, ser
     assert record.verdict == "pass" and record.document == doc
     assert "{serial}" in refused("capture", "--port", "x", "-o", tmp_path / "a.csv", "--guide", "servo", "--unit", "A",
                                  "--next")
+
+
+def _station_run(tmp_path, servo, *extra, answer=None, limits="min = 0.97\nmax = 1.03\n"):
+    lim = tmp_path / "limits.toml"
+    lim.write_text(f"guard = 2\n[limits.k]\n{limits}")
+    with VirtualDevice(device_bytes(servo, "frames", encoder="c"), answer=answer) as dev:
+        run = start(dev, "-o", tmp_path / "rec.csv", "--guide", "servo", "--unit", "SN-7", "--limits", lim,
+                    "--store", tmp_path / "station.db", "--write-back", *extra)
+        return (*run.finish(), json.loads((tmp_path / "rec.cal.json").read_text()))
+
+
+def test_write_back_after_a_pass_is_stored_and_read_back_by_the_device(tmp_path, servo):
+    """--write-back after a pass: the virtual device receives the set-calibration frame with the C library's receiver,
+    writes it to its RAM flash page, reads it back and echoes it. References: the calibration file's own correction
+    rounded to float32 (what was sent), and the C side's page, parsed again in Python."""
+    from gyrocal.capture.c_device import CStorage
+
+    storage = CStorage()
+    code, stdout, err, doc = _station_run(tmp_path, servo, answer=storage)
+    assert code == 0, err
+    assert "SN-7: written to the device and read back" in stdout and stdout.rstrip().endswith("SN-7: PASS")
+    sent = np.asarray(doc["correction"]["matrix"], dtype=np.float32)
+    device = doc["device"]
+    assert doc["units"]["output"] == "deg/s" and device["rate_unit"] == "deg/s"  # the hello's unit, as the file
+    assert device["written_back"] is True and device["applied"] is True
+    np.testing.assert_array_equal(np.asarray(device["matrix"], np.float32), sent)
+    (page,) = fr.FrameDecoder().feed(storage.page)
+    np.testing.assert_array_equal(np.asarray(page.matrix, np.float32).reshape(3, 3), sent)
+    np.testing.assert_array_equal(np.float32(page.offset), np.float32(doc["correction"]["offset"]))
+    assert storage.applied == (*page.matrix, *page.offset)
+
+
+def test_a_failed_unit_is_never_written_back(tmp_path, servo):
+    from gyrocal.capture.c_device import CStorage
+
+    storage = CStorage()
+    code, stdout, err, doc = _station_run(tmp_path, servo, answer=storage, limits="min = 0.99\nmax = 1.01\n")
+    assert code == 1 and "SN-7: FAIL" in stdout, err
+    assert storage.page == b"" and "written to the device" not in stdout and "device" not in doc
+
+
+def test_write_back_to_a_device_that_never_answers_is_refused_in_one_line(tmp_path, servo):
+    """No answer within --write-back-timeout: exit 2 with one line; the file and the record say it was not written."""
+    import time
+
+    t0 = time.monotonic()
+    code, stdout, err, doc = _station_run(tmp_path, servo, "--write-back-timeout", "0.5")
+    assert code == 2 and len(err.strip().splitlines()) == 1 and "no answer from the device within 0.5 s" in err
+    assert "--write-back-timeout" in err and time.monotonic() - t0 < WAIT
+    assert doc["device"]["written_back"] is False
+
+
+def test_write_back_refuses_an_echo_that_differs(tmp_path, servo):
+    from gyrocal.capture.c_device import CStorage
+
+    storage = CStorage()
+
+    def flip(data: bytes) -> bytes:  # a storage that loses one bit of the matrix
+        out = bytearray(storage(data))
+        if out:
+            out[20] ^= 1
+            out[-2:] = fr.crc16(bytes(out[2:-2])).to_bytes(2, "little")
+        return bytes(out)
+
+    code, stdout, err, doc = _station_run(tmp_path, servo, answer=flip)
+    assert code == 2 and "read back another calibration" in err and len(err.strip().splitlines()) == 1
+    assert doc["device"]["written_back"] is False

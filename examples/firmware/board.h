@@ -1,6 +1,6 @@
 /*
  * board.h: the board layer of the gyrocal example firmware. A port (Arduino, STM32 HAL, Pico SDK, a
- * host test) provides these four functions; everything else is portable C99.
+ * host test) provides these functions; everything else is portable C99.
  */
 #ifndef GYROCAL_EXAMPLE_BOARD_H
 #define GYROCAL_EXAMPLE_BOARD_H
@@ -22,6 +22,13 @@ void board_write(const uint8_t *data, size_t n);
 /* Free-running clocks since power-up [us] and [ms], wrapping at 2^32. */
 uint32_t board_micros(void);
 uint32_t board_millis(void);
+/* Bytes the host sent (`gyrocal capture --write-back`), without waiting: up to cap of them into data; returns how
+ * many (0: none yet). A board that never listens returns 0. */
+size_t board_receive(uint8_t *data, size_t cap);
+/* The calibration's storage (a flash page, an EEPROM): write n bytes, or read n bytes back; 0 on success. The
+ * firmware reads back what it wrote and answers the host with that, so a write that did not take shows. */
+int board_store(const uint8_t *data, size_t n);
+int board_load(uint8_t *data, size_t n);
 
 #ifdef __cplusplus
 }

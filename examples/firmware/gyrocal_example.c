@@ -26,9 +26,10 @@ void example_setup(example_t *ex, float sample_rate, float sensitivity, uint16_t
     gyrocal_hello_t hello;
     size_t i;
     gyrocal_session_init(&ex->session, sample_rate, sensitivity, 360.0f);
-    ex->calibrated = 0;
+    ex->calibrated = ex->host_cal = 0;
     ex->send_accel = accel_sensitivity != 0u;
     ex->seq = 0u;
+    gyrocal_frame_rx_reset(&ex->rx);
     hello.sample_rate = sample_rate;
     hello.sensitivity = sensitivity;
     hello.rate_unit = GYROCAL_UNIT_DEG_S;
@@ -55,9 +56,55 @@ static void report(example_t *ex, unsigned events)
         board_write(ex->frame, gyrocal_frame_result(ex->frame, s->status, GYROCAL_METHOD_FIRST_MOMENT,
                                                     (uint8_t)s->iterations, GYROCAL_N_OBS,
                                                     s->status == GYROCAL_OK ? &s->result : 0, s->seq - 1u));
-        if (s->status == GYROCAL_OK) {
+        if (s->status == GYROCAL_OK && !ex->host_cal) { /* the host's calibration, once applied, stays */
             gyrocal_scale_bias_to_affine(&s->result, &ex->cal);
             ex->calibrated = 1;
+        }
+    }
+}
+
+/* The host's write-back: store the request as its own frame (the frame's CRC then checks the read-back), read it
+ * back, answer with what the storage holds, and with GYROCAL_SETCAL_APPLY correct the samples with it from now on. */
+static void store_calibration(example_t *ex)
+{
+    gyrocal_set_calibration_t req, back;
+    gyrocal_frame_rx_t rx;
+    uint8_t page[GYROCAL_FRAME_MAX];
+    size_t n, i;
+    unsigned type = 0u;
+    gyrocal_frame_rx_reset(&rx);
+    if (gyrocal_parse_set_calibration(ex->rx.buf + 4, ex->rx.buf[3], &req) != GYROCAL_OK) {
+        board_write(ex->frame, gyrocal_frame_calibration_stored(ex->frame, GYROCAL_STORED_INVALID, 0));
+        return;
+    }
+    n = gyrocal_frame_set_calibration(page, &req);
+    if (board_store(page, n) == 0 && board_load(page, n) == 0) {
+        for (i = 0; i < n; ++i) {
+            type = gyrocal_frame_rx_byte(&rx, page[i]);
+        }
+    }
+    if (type != GYROCAL_FRAME_SET_CALIBRATION
+        || gyrocal_parse_set_calibration(rx.buf + 4, rx.buf[3], &back) != GYROCAL_OK) {
+        board_write(ex->frame, gyrocal_frame_calibration_stored(ex->frame, GYROCAL_STORED_FAILED, 0));
+        return;
+    }
+    if (back.flags & GYROCAL_SETCAL_APPLY) {
+        ex->cal = back.cal;
+        ex->calibrated = 1;
+        ex->host_cal = 1;
+    }
+    board_write(ex->frame, gyrocal_frame_calibration_stored(ex->frame, GYROCAL_STORED_OK, &back));
+}
+
+static void receive(example_t *ex)
+{
+    uint8_t data[16];
+    size_t n, i;
+    while ((n = board_receive(data, sizeof data)) > 0u) {
+        for (i = 0; i < n; ++i) {
+            if (gyrocal_frame_rx_byte(&ex->rx, data[i]) == GYROCAL_FRAME_SET_CALIBRATION) {
+                store_calibration(ex);
+            }
         }
     }
 }
@@ -78,6 +125,7 @@ int example_step(example_t *ex)
     if (events) {
         report(ex, events);
     }
+    receive(ex);
 #if EXAMPLE_SEND_CALIBRATED
     if (ex->calibrated) {
         float x[3] = {(float)raw[0], (float)raw[1], (float)raw[2]}, w[3];

@@ -79,6 +79,39 @@ uint32_t board_millis(void)
     return board_micros() / 1000u;
 }
 
+size_t board_receive(uint8_t *data, size_t cap) /* this demo has no host to listen to */
+{
+    (void)data;
+    (void)cap;
+    return 0u;
+}
+
+static uint8_t flash_page[GYROCAL_FRAME_MAX]; /* RAM stands in for the flash page */
+
+int board_store(const uint8_t *data, size_t n)
+{
+    size_t i;
+    if (n > sizeof flash_page) {
+        return 1;
+    }
+    for (i = 0; i < n; ++i) {
+        flash_page[i] = data[i];
+    }
+    return 0;
+}
+
+int board_load(uint8_t *data, size_t n)
+{
+    size_t i;
+    if (n > sizeof flash_page) {
+        return 1;
+    }
+    for (i = 0; i < n; ++i) {
+        data[i] = flash_page[i];
+    }
+    return 0;
+}
+
 int main(void)
 {
     static example_t ex;

@@ -123,11 +123,69 @@ static void test_session_finds_the_six_turns(void)
     }
 }
 
+static void test_set_calibration_round_trip(void)
+{
+    /* seq 7, apply, deg/s; matrix[0][0] = 1.0f (00 00 80 3F), offset[2] = -2.5f (00 00 20 C0) */
+    static const uint8_t head[8] = {7, 0, 0, 0, GYROCAL_SETCAL_APPLY, GYROCAL_UNIT_DEG_S, 0, 0};
+    static const uint8_t one[4] = {0x00, 0x00, 0x80, 0x3F}, minus[4] = {0x00, 0x00, 0x20, 0xC0};
+    gyrocal_set_calibration_t set = {7u, GYROCAL_SETCAL_APPLY, GYROCAL_UNIT_DEG_S,
+                                     {{{1.0f, 0.01f, -0.02f}, {0.0f, 0.98f, 0.0f}, {1e-3f, 0.0f, 7.6e-3f}},
+                                      {1.5f, 12.0f, -2.5f}}};
+    gyrocal_set_calibration_t got;
+    gyrocal_frame_rx_t rx;
+    uint8_t out[GYROCAL_FRAME_MAX], echo[GYROCAL_FRAME_MAX], bad[GYROCAL_FRAME_MAX];
+    size_t n, i;
+    unsigned type = 0u, seen = 0u;
+    n = gyrocal_frame_set_calibration(out, &set);
+    CHECK(n == GYROCAL_FRAME_SET_CALIBRATION_SIZE && out[2] == GYROCAL_FRAME_SET_CALIBRATION && out[3] == 56u);
+    CHECK(memcmp(out + 4, head, 8) == 0 && memcmp(out + 12, one, 4) == 0 && memcmp(out + 56, minus, 4) == 0);
+    /* noise, a false sync, then a frame with a flipped bit (dropped), then the good one */
+    memcpy(bad, out, n);
+    bad[20] ^= 0x10u;
+    gyrocal_frame_rx_reset(&rx);
+    for (i = 0; i < 3; ++i) {
+        seen |= gyrocal_frame_rx_byte(&rx, i == 1u ? 0xA5u : 0x00u);
+    }
+    for (i = 0; i < n; ++i) {
+        seen |= gyrocal_frame_rx_byte(&rx, bad[i]);
+    }
+    for (i = 0; i < n; ++i) {
+        type = gyrocal_frame_rx_byte(&rx, out[i]);
+        CHECK(i + 1u == n || type == 0u);
+    }
+    CHECK(seen == 0u && type == GYROCAL_FRAME_SET_CALIBRATION);
+    /* a false start whose length byte is the real frame's sync: the receiver finds that sync again */
+    seen = gyrocal_frame_rx_byte(&rx, 0xA5u) | gyrocal_frame_rx_byte(&rx, 0x5Au) | gyrocal_frame_rx_byte(&rx, 7u);
+    for (i = 0; i < n; ++i) {
+        type = gyrocal_frame_rx_byte(&rx, out[i]);
+    }
+    CHECK(seen == 0u && type == GYROCAL_FRAME_SET_CALIBRATION);
+    CHECK(gyrocal_parse_set_calibration(rx.buf + 4, rx.buf[3], &got) == GYROCAL_OK);
+    CHECK(memcmp(&got.cal, &set.cal, sizeof set.cal) == 0 && got.seq == 7u && got.flags == set.flags);
+    /* the echo is the request with another type and its status byte */
+    CHECK(gyrocal_frame_calibration_stored(echo, GYROCAL_STORED_OK, &got) == n);
+    CHECK(echo[2] == GYROCAL_FRAME_CALIBRATION_STORED && memcmp(echo + 3, out + 3, n - 5u) == 0);
+    CHECK(gyrocal_frame_calibration_stored(echo, GYROCAL_STORED_FAILED, 0) == n && echo[10] == 2u && echo[12] == 0u);
+    /* refused: a NaN, an unknown unit, a wrong length, NULL; *out untouched */
+    memset(&got, 0, sizeof got);
+    memcpy(bad, out, n);
+    bad[15] = 0x7Fu;
+    bad[14] = 0xC0u;
+    CHECK(gyrocal_parse_set_calibration(bad + 4, 56u, &got) == GYROCAL_E_INPUT && got.seq == 0u);
+    memcpy(bad, out, n);
+    bad[9] = 2u;
+    CHECK(gyrocal_parse_set_calibration(bad + 4, 56u, &got) == GYROCAL_E_INPUT && got.seq == 0u);
+    CHECK(gyrocal_parse_set_calibration(out + 4, 55u, &got) == GYROCAL_E_INPUT);
+    CHECK(gyrocal_parse_set_calibration(0, 56u, &got) == GYROCAL_E_INPUT);
+    CHECK(gyrocal_frame_set_calibration(out, 0) == 0u && gyrocal_frame_rx_byte(0, 0xA5u) == 0u);
+}
+
 int main(void)
 {
     test_crc_and_sample_frame();
     test_imu_and_end_frames();
     test_null_and_limits();
     test_session_finds_the_six_turns();
+    test_set_calibration_round_trip();
     return failures;
 }

@@ -11,9 +11,13 @@
 // The portable files come from the gyrocal repository; copy them next to this sketch first:
 //     bash examples/arduino/make_sketch.sh            (from the repository root)
 // Wiring (3.3 V boards, or a 5 V board with a level-shifting breakout): VCC, GND, SDA, SCL; AD0 low.
-// Board layer: the four functions of board.h, below.
+// Board layer: the functions of board.h, below. `gyrocal capture ... --write-back` sends the accepted
+// calibration back; the board keeps it in EEPROM (AVR boards; elsewhere in RAM until a port adds its flash).
 
 #include <Wire.h>
+#if defined(ARDUINO_ARCH_AVR)
+#include <EEPROM.h>
+#endif
 
 extern "C" {
 #include "board.h"
@@ -76,6 +80,57 @@ extern "C" uint32_t board_micros(void)
 extern "C" uint32_t board_millis(void)
 {
     return millis();
+}
+
+extern "C" size_t board_receive(uint8_t *data, size_t cap)
+{
+    size_t n = 0;
+    while (n < cap && Serial.available() > 0) {
+        data[n++] = (uint8_t)Serial.read();
+    }
+    return n;
+}
+
+#if defined(ARDUINO_ARCH_AVR)
+static const int STORE_AT = 0; // EEPROM address of the calibration record
+#else
+static uint8_t page[GYROCAL_FRAME_MAX]; // stands in for a flash page
+#endif
+
+extern "C" int board_store(const uint8_t *data, size_t n)
+{
+#if defined(ARDUINO_ARCH_AVR)
+    if (STORE_AT + n > EEPROM.length()) {
+        return 1;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        EEPROM.update(STORE_AT + (int)i, data[i]); // update: unchanged bytes are not rewritten (wear)
+    }
+#else
+    if (n > sizeof page) {
+        return 1;
+    }
+    memcpy(page, data, n);
+#endif
+    return 0;
+}
+
+extern "C" int board_load(uint8_t *data, size_t n)
+{
+#if defined(ARDUINO_ARCH_AVR)
+    if (STORE_AT + n > EEPROM.length()) {
+        return 1;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        data[i] = EEPROM.read(STORE_AT + (int)i);
+    }
+#else
+    if (n > sizeof page) {
+        return 1;
+    }
+    memcpy(data, page, n);
+#endif
+    return 0;
 }
 
 void setup()

@@ -1,5 +1,6 @@
 /*
- * gyrocal_frame.c: gyrocal frame encoder (part of gyrocal, MIT licence). See gyrocal_frame.h.
+ * gyrocal_frame.c: gyrocal frame encoder, and the receiver of host frames (part of gyrocal, MIT licence).
+ * See gyrocal_frame.h.
  * Fields are written byte by byte with shifts, so the output is the same on any endianness.
  */
 #include "gyrocal_frame.h"
@@ -204,4 +205,147 @@ size_t gyrocal_frame_end(uint8_t out[GYROCAL_FRAME_MAX], uint32_t n_samples)
     }
     put_u32(out + 4, n_samples);
     return gyrocal_frame(out, GYROCAL_FRAME_END, out + 4, GYROCAL_FRAME_END_LEN);
+}
+
+/* seq, flags, rate unit, a byte (the status of an answer, 0 in a request), a reserved byte, matrix row by row,
+ * offset: both frames have this layout, so an echo is the request with its status filled in. */
+static size_t put_calibration(uint8_t out[GYROCAL_FRAME_MAX], uint8_t type, uint8_t status,
+                              const gyrocal_set_calibration_t *c)
+{
+    uint8_t *p = put_u32(out + 4, c ? c->seq : 0u);
+    int i, j;
+    *p++ = c ? c->flags : 0u;
+    *p++ = c ? c->rate_unit : 0u;
+    *p++ = status;
+    *p++ = 0u;
+    for (i = 0; i < 3; ++i) {
+        for (j = 0; j < 3; ++j) {
+            p = put_f32(p, c ? c->cal.matrix[i][j] : 0.0f);
+        }
+    }
+    for (i = 0; i < 3; ++i) {
+        p = put_f32(p, c ? c->cal.offset[i] : 0.0f);
+    }
+    return gyrocal_frame(out, type, out + 4, GYROCAL_FRAME_SET_CALIBRATION_LEN);
+}
+
+size_t gyrocal_frame_set_calibration(uint8_t out[GYROCAL_FRAME_MAX], const gyrocal_set_calibration_t *set)
+{
+    if (out == 0 || set == 0) {
+        return 0u;
+    }
+    return put_calibration(out, GYROCAL_FRAME_SET_CALIBRATION, 0u, set);
+}
+
+size_t gyrocal_frame_calibration_stored(uint8_t out[GYROCAL_FRAME_MAX], uint8_t status,
+                                        const gyrocal_set_calibration_t *stored)
+{
+    if (out == 0) {
+        return 0u;
+    }
+    return put_calibration(out, GYROCAL_FRAME_CALIBRATION_STORED, status, stored);
+}
+
+static uint32_t get_u32(const uint8_t *p)
+{
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
+}
+
+/* The float at p; *bad is set when it is a NaN or an infinity (all exponent bits set: no libc needed). */
+static float get_f32(const uint8_t *p, int *bad)
+{
+    union {
+        float f;
+        uint32_t u;
+    } bits;
+    bits.u = get_u32(p);
+    if ((bits.u & 0x7F800000u) == 0x7F800000u) {
+        *bad = 1;
+    }
+    return bits.f;
+}
+
+gyrocal_status_t gyrocal_parse_set_calibration(const uint8_t *payload, size_t len, gyrocal_set_calibration_t *out)
+{
+    gyrocal_set_calibration_t c;
+    const uint8_t *p;
+    int i, j, bad = 0;
+    if (payload == 0 || out == 0 || len != GYROCAL_FRAME_SET_CALIBRATION_LEN) {
+        return GYROCAL_E_INPUT;
+    }
+    c.seq = get_u32(payload);
+    c.flags = payload[4];
+    c.rate_unit = payload[5];
+    p = payload + 8;
+    for (i = 0; i < 3; ++i) {
+        for (j = 0; j < 3; ++j, p += 4) {
+            c.cal.matrix[i][j] = get_f32(p, &bad);
+        }
+    }
+    for (i = 0; i < 3; ++i, p += 4) {
+        c.cal.offset[i] = get_f32(p, &bad);
+    }
+    if (bad || c.rate_unit > GYROCAL_UNIT_DEG_S) {
+        return GYROCAL_E_INPUT;
+    }
+    *out = c;
+    return GYROCAL_OK;
+}
+
+void gyrocal_frame_rx_reset(gyrocal_frame_rx_t *rx)
+{
+    if (rx != 0) {
+        rx->len = 0u;
+    }
+}
+
+/* The bytes held did not make a frame (a length too large, a CRC that does not match): keep them from the next sync
+ * on, as the host's decoder does, so a false start does not swallow the frame that follows it. */
+static void rx_resync(gyrocal_frame_rx_t *rx)
+{
+    uint8_t i, j;
+    do {
+        for (i = 1u; i < rx->len; ++i) {
+            if (rx->buf[i] == GYROCAL_FRAME_SYNC0 && (i + 1u == rx->len || rx->buf[i + 1u] == GYROCAL_FRAME_SYNC1)) {
+                break;
+            }
+        }
+        for (j = 0u; i < rx->len; ++i, ++j) {
+            rx->buf[j] = rx->buf[i];
+        }
+        rx->len = j;
+    } while (rx->len >= 4u && rx->buf[3] > GYROCAL_FRAME_MAX_PAYLOAD);
+}
+
+unsigned gyrocal_frame_rx_byte(gyrocal_frame_rx_t *rx, uint8_t byte)
+{
+    size_t n;
+    uint16_t crc;
+    if (rx == 0) {
+        return 0u;
+    }
+    if (rx->len >= GYROCAL_FRAME_MAX || (rx->len == 0u && byte != GYROCAL_FRAME_SYNC0)) {
+        rx->len = 0u;
+        return 0u;
+    }
+    if (rx->len == 1u && byte != GYROCAL_FRAME_SYNC1) {
+        rx->len = byte == GYROCAL_FRAME_SYNC0 ? 1u : 0u; /* A5 A5 5A: the second A5 may start the frame */
+        return 0u;
+    }
+    rx->buf[rx->len++] = byte;
+    if (rx->len == 4u && rx->buf[3] > GYROCAL_FRAME_MAX_PAYLOAD) {
+        rx_resync(rx);
+        return 0u;
+    }
+    n = rx->len < 4u ? GYROCAL_FRAME_MAX : (size_t)rx->buf[3] + GYROCAL_FRAME_OVERHEAD;
+    if (rx->len < n) {
+        return 0u;
+    }
+    crc = gyrocal_crc16(rx->buf + 2, n - 4u, 0xFFFFu);
+    if (rx->buf[n - 2u] != (crc & 0xFFu) || rx->buf[n - 1u] != (crc >> 8)) {
+        rx_resync(rx);
+        return 0u;
+    }
+    rx->len = 0u;
+    return rx->buf[2];
 }

@@ -1,10 +1,11 @@
 /*
- * gyrocal_frame.h: gyrocal frames, the binary wire format from a device to `gyrocal capture`
- * (part of gyrocal, MIT licence). docs/capture.md has the byte tables.
+ * gyrocal_frame.h: gyrocal frames, the binary wire format between a device and `gyrocal capture`
+ * (part of gyrocal, MIT licence). docs/capture.md has the byte tables. Frames go from the device to the
+ * host, except GYROCAL_FRAME_SET_CALIBRATION (host to device), which gyrocal_frame_rx_byte receives.
  *
  * C99, no dynamic memory, no static data, nothing from libc. Every encoder writes one whole frame
  * into a caller buffer of GYROCAL_FRAME_MAX bytes and returns its length; a NULL pointer (other than
- * the result's parameters, sent as zeros) writes nothing and returns 0.
+ * the result's parameters and a refusal's stored correction, sent as zeros) writes nothing and returns 0.
  *
  * A frame:  0xA5 0x5A | type (1) | payload length L (1, <= GYROCAL_FRAME_MAX_PAYLOAD) | payload (L) |
  *           CRC-16 (2)
@@ -40,6 +41,8 @@ extern "C" {
 #define GYROCAL_FRAME_TEXT 0x06u        /* a message for the person at the host, UTF-8 */
 #define GYROCAL_FRAME_IMU 0x07u         /* one raw 6-axis sample: gyro and accelerometer counts, stamp, temperature */
 #define GYROCAL_FRAME_END 0x08u         /* the session is over: the device sends nothing more */
+#define GYROCAL_FRAME_SET_CALIBRATION 0x09u    /* host to device: a correction to store (and apply) */
+#define GYROCAL_FRAME_CALIBRATION_STORED 0x0Au /* device to host: the correction read back from storage */
 #define GYROCAL_FRAME_HELLO_LEN 32u
 #define GYROCAL_FRAME_SAMPLE_LEN 16u
 #define GYROCAL_FRAME_CALIBRATED_LEN 20u
@@ -47,6 +50,9 @@ extern "C" {
 #define GYROCAL_FRAME_RESULT_LEN 32u
 #define GYROCAL_FRAME_IMU_LEN 22u
 #define GYROCAL_FRAME_END_LEN 4u
+#define GYROCAL_FRAME_SET_CALIBRATION_LEN 56u
+#define GYROCAL_FRAME_CALIBRATION_STORED_LEN 56u
+#define GYROCAL_FRAME_SET_CALIBRATION_SIZE (GYROCAL_FRAME_OVERHEAD + GYROCAL_FRAME_SET_CALIBRATION_LEN)
 #define GYROCAL_FRAME_SAMPLE_SIZE (GYROCAL_FRAME_OVERHEAD + GYROCAL_FRAME_SAMPLE_LEN)
 #define GYROCAL_FRAME_IMU_SIZE (GYROCAL_FRAME_OVERHEAD + GYROCAL_FRAME_IMU_LEN)
 
@@ -88,6 +94,29 @@ typedef struct {
 #define GYROCAL_TURN_OFF_AXIS 2u
 #define GYROCAL_TURN_TOO_LONG 3u
 
+/* A correction sent by the host (GYROCAL_FRAME_SET_CALIBRATION) and echoed by the device, as it read it back
+ * from its storage (GYROCAL_FRAME_CALIBRATION_STORED): w = cal.matrix (raw - cal.offset), raw and offset in
+ * counts, w in rate_unit. */
+typedef struct {
+    uint32_t seq;       /* the host's request number, echoed so that an answer matches its request */
+    uint8_t flags;      /* GYROCAL_SETCAL_* */
+    uint8_t rate_unit;  /* GYROCAL_UNIT_* of the corrected rates */
+    gyrocal_affine_t cal;
+} gyrocal_set_calibration_t;
+
+/* Set-calibration flags. */
+#define GYROCAL_SETCAL_APPLY 1u /* correct the samples from now on (else only store, for the next start) */
+/* Status of a calibration-stored frame. */
+#define GYROCAL_STORED_OK 0u      /* stored, and what follows is what the storage holds now */
+#define GYROCAL_STORED_INVALID 1u /* refused: a value not finite, or an unknown unit; nothing stored */
+#define GYROCAL_STORED_FAILED 2u  /* the storage did not take it, or did not read back a valid record */
+
+/* Receiver of host frames, fed byte by byte (a UART interrupt, a poll loop). */
+typedef struct {
+    uint8_t buf[GYROCAL_FRAME_MAX]; /* the frame so far: buf[2] its type, buf[3] its length, payload at buf + 4 */
+    uint8_t len;
+} gyrocal_frame_rx_t;
+
 /* CRC-16/CCITT-FALSE of n bytes, continuing from crc (start with 0xFFFF). */
 uint16_t gyrocal_crc16(const uint8_t *data, size_t n, uint16_t crc);
 
@@ -112,6 +141,21 @@ size_t gyrocal_frame_text(uint8_t out[GYROCAL_FRAME_MAX], const char *text);
 /* The end of the session (a recorded or simulated one; a live board never ends): n_samples sample or IMU
  * frames were sent in all. The host knows it has everything once it has read this frame. */
 size_t gyrocal_frame_end(uint8_t out[GYROCAL_FRAME_MAX], uint32_t n_samples);
+/* The host's request to store a correction (what gyrocal capture --write-back sends). */
+size_t gyrocal_frame_set_calibration(uint8_t out[GYROCAL_FRAME_MAX], const gyrocal_set_calibration_t *set);
+/* The device's answer: status GYROCAL_STORED_*, and the correction read back from storage (NULL: zeros, for a
+ * refusal). */
+size_t gyrocal_frame_calibration_stored(uint8_t out[GYROCAL_FRAME_MAX], uint8_t status,
+                                        const gyrocal_set_calibration_t *stored);
+/* The payload of a set-calibration frame (len bytes) into *out: GYROCAL_E_INPUT for a wrong length, a value not
+ * finite or an unknown unit (then *out is untouched). */
+gyrocal_status_t gyrocal_parse_set_calibration(const uint8_t *payload, size_t len, gyrocal_set_calibration_t *out);
+
+void gyrocal_frame_rx_reset(gyrocal_frame_rx_t *rx);
+/* Take one byte; returns the type of the frame it completes when its CRC is good (its payload at rx->buf + 4,
+ * rx->buf[3] bytes, valid until the next call), else 0. Bytes that make no frame (a length too large, a bad CRC)
+ * are dropped up to the next sync among them, so the search goes on from there. */
+unsigned gyrocal_frame_rx_byte(gyrocal_frame_rx_t *rx, uint8_t byte);
 
 #ifdef __cplusplus
 }

@@ -17,7 +17,7 @@ import numpy as np
 from ..firmware import C_LIBRARY_VERSION, CLibrary, load_library
 from .frames import TURN_LABELS
 
-__all__ = ["CDevice", "firmware_stream"]
+__all__ = ["CDevice", "CStorage", "firmware_stream"]
 
 _F3 = ctypes.c_float * 3
 _BUF = ctypes.c_uint8 * 70  # GYROCAL_FRAME_MAX
@@ -62,6 +62,17 @@ class _Session(ctypes.Structure):
     ]
 
 
+class _SetCal(ctypes.Structure):
+    """gyrocal_set_calibration_t (its gyrocal_affine_t flattened: the same layout)."""
+
+    _fields_ = [("seq", ctypes.c_uint32), ("flags", ctypes.c_uint8), ("rate_unit", ctypes.c_uint8),
+                ("matrix", _F3 * 3), ("offset", _F3)]
+
+
+class _Rx(ctypes.Structure):
+    _fields_ = [("buf", ctypes.c_uint8 * 70), ("len", ctypes.c_uint8)]
+
+
 _P = ctypes.POINTER
 _U8P = _P(ctypes.c_uint8)
 _SIGNATURES = {
@@ -77,6 +88,10 @@ _SIGNATURES = {
     "gyrocal_frame_result": (ctypes.c_size_t, [_U8P, ctypes.c_int, ctypes.c_uint8, ctypes.c_uint8, ctypes.c_uint8,
                                                _P(_ScaleBias), ctypes.c_uint32]),
     "gyrocal_frame_text": (ctypes.c_size_t, [_U8P, ctypes.c_char_p]),
+    "gyrocal_frame_set_calibration": (ctypes.c_size_t, [_U8P, _P(_SetCal)]),
+    "gyrocal_frame_calibration_stored": (ctypes.c_size_t, [_U8P, ctypes.c_uint8, _P(_SetCal)]),
+    "gyrocal_parse_set_calibration": (ctypes.c_int, [_U8P, ctypes.c_size_t, _P(_SetCal)]),
+    "gyrocal_frame_rx_byte": (ctypes.c_uint, [_P(_Rx), ctypes.c_uint8]),
     "gyrocal_session_init": (ctypes.c_int, [_P(_Session), ctypes.c_float, ctypes.c_float, ctypes.c_float]),
     "gyrocal_session_add": (ctypes.c_uint, [_P(_Session), _P(ctypes.c_int16)]),
     "gyrocal_scale_bias_to_affine": (ctypes.c_int, [_P(_ScaleBias), ctypes.c_void_p]),
@@ -134,6 +149,14 @@ class CDevice:
     def text(self, text: str) -> bytes:
         return self._out(self.dll.gyrocal_frame_text(self._buf, text.encode()))
 
+    def set_calibration(self, seq: int, flags: int, rate_unit: int, matrix, offset, status: int | None = None) -> bytes:
+        """A set-calibration frame (`status` None), or with a status the calibration-stored frame echoing it."""
+        c = _SetCal(seq & 0xFFFFFFFF, flags, rate_unit, (_F3 * 3)(*(_F3(*row) for row in np.reshape(matrix, (3, 3)))),
+                    _F3(*offset))
+        if status is None:
+            return self._out(self.dll.gyrocal_frame_set_calibration(self._buf, ctypes.byref(c)))
+        return self._out(self.dll.gyrocal_frame_calibration_stored(self._buf, status, ctypes.byref(c)))
+
     def _events(self, s: _Session, events: int) -> bytes:
         out = b""
         if events & 1:
@@ -178,6 +201,53 @@ class CDevice:
                 parts.append(self.calibrated(i, t, w))
         parts.append(self.end(len(raw)))
         return b"".join(parts)
+
+
+class CStorage:
+    """A device's answer to the host's set-calibration frames, in the C library, as the example firmware gives it:
+    bytes received one at a time (``gyrocal_frame_rx_byte``), the request parsed, its frame written to a RAM
+    "flash" page, the page read back and parsed again, and what it holds echoed in a calibration-stored frame.
+
+    Call it with the bytes the host sent; it returns the bytes to send back. ``page`` is the flash page,
+    ``applied`` the correction in use (a ``gyrocal_affine_t`` as 12 floats) once a request asked for it.
+    """
+
+    SET, APPLY = 0x09, 1  # GYROCAL_FRAME_SET_CALIBRATION, GYROCAL_SETCAL_APPLY
+
+    def __init__(self, device: CDevice | None = None):
+        self.dev = device or CDevice()
+        self._rx = _Rx()
+        self.page = b""
+        self.applied: tuple[float, ...] | None = None
+
+    def __call__(self, data: bytes) -> bytes:
+        out = b""
+        for byte in data:
+            if self.dev.dll.gyrocal_frame_rx_byte(ctypes.byref(self._rx), byte) == self.SET:
+                out += self._store(bytes(self._rx.buf[4:4 + self._rx.buf[3]]))
+        return out
+
+    def _parse(self, payload: bytes) -> _SetCal | None:
+        got = _SetCal()
+        buf = (ctypes.c_uint8 * len(payload)).from_buffer_copy(payload)
+        return got if self.dev.dll.gyrocal_parse_set_calibration(buf, len(payload), ctypes.byref(got)) == 0 else None
+
+    def _store(self, payload: bytes) -> bytes:
+        dll, buf = self.dev.dll, self.dev._buf
+        req = self._parse(payload)
+        if req is None:
+            return self.dev._out(dll.gyrocal_frame_calibration_stored(buf, 1, None))  # GYROCAL_STORED_INVALID
+        self.page = self.dev._out(dll.gyrocal_frame_set_calibration(buf, ctypes.byref(req)))
+        rx = _Rx()  # the read-back goes through the receiver too: the page's CRC checks it
+        back = None
+        for byte in self.page:
+            if dll.gyrocal_frame_rx_byte(ctypes.byref(rx), byte) == self.SET:
+                back = self._parse(bytes(rx.buf[4:4 + rx.buf[3]]))
+        if back is None:
+            return self.dev._out(dll.gyrocal_frame_calibration_stored(buf, 2, None))  # GYROCAL_STORED_FAILED
+        if back.flags & self.APPLY:
+            self.applied = (*(v for row in back.matrix for v in row), *back.offset)
+        return self.dev._out(dll.gyrocal_frame_calibration_stored(buf, 0, ctypes.byref(back)))
 
 
 def firmware_stream(raw, t_us, temp=None, *, sample_rate: float, sensitivity: float, **kwargs) -> bytes:

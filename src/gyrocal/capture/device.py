@@ -31,6 +31,7 @@ import termios
 import threading
 import time
 import tty
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Literal, Self
 
@@ -39,7 +40,7 @@ import numpy as np
 from ..errors import InputError
 from .frames import End, FrameDecoder, Hello, encode, encode_samples
 from .simulated import DeviceSession
-from .text import END_LINE
+from .text import END_LINE, text_lines
 
 __all__ = ["Faults", "VirtualDevice", "damage", "device_bytes", "parse_faults", "preamble", "text_lines"]
 
@@ -126,22 +127,6 @@ def damage(data: bytes, faults: Faults) -> tuple[bytes, Damage]:
     return buf[keep].tobytes(), Damage(dropped, corrupted)
 
 
-def text_lines(session: DeviceSession) -> bytes:
-    """The session as an Arduino sketch prints it with ``Serial.println``: ``t_us,gx,gy,gz[,temp][,ax,ay,az]``,
-    then the end-of-session line."""
-    head = "t_us,gx,gy,gz" + (",temp" if session.temp is not None else "")
-    cols = [session.t_us.astype(str), *(session.raw[:, j].astype(str) for j in range(3))]
-    if session.temp is not None:
-        cols.append(np.char.mod("%.2f", session.temp))
-    if session.accel is not None:
-        head += ",ax,ay,az"
-        cols += [session.accel[:, j].astype(str) for j in range(3)]
-    rows = cols[0]
-    for c in cols[1:]:
-        rows = np.char.add(np.char.add(rows, ","), c)
-    return (head + "\r\n" + "\r\n".join(rows.tolist()) + "\r\n" + END_LINE + "\r\n").encode()
-
-
 def device_bytes(session: DeviceSession, wire: Wire = "frames", encoder: Literal["c", "python"] = "c") -> bytes:
     """What a device sends for `session`: text lines, or gyrocal frames from the C library (the example
     firmware: samples, turns, its own calibration and corrected samples) or from Python (samples only);
@@ -194,12 +179,16 @@ class VirtualDevice:
         the queue; for people, not for tests).
     drain_timeout : float
         Longest wait for the reader to take everything or to hang up [s].
+    answer : callable(bytes) -> bytes, optional
+        What the device answers to bytes the host sends (``CStorage``: the write-back), on a
+        pseudo-terminal; without it the device never reads what the host sends.
     """
 
     def __init__(self, data: bytes, *, faults: Faults = Faults(), byte_rate: float | None = None,
                  transport: Literal["pty", "tcp"] = "pty", chunk: int = 256, drain_timeout: float = 60.0,
-                 wait_for: Literal["release", "reader"] = "release"):
+                 wait_for: Literal["release", "reader"] = "release", answer: Callable[[bytes], bytes] | None = None):
         self.data, self.faults, self.byte_rate, self.transport = data, faults, byte_rate, transport
+        self.answer = answer
         self.wait_for = wait_for
         self._go = threading.Event()
         self.paused = threading.Event()  # set once the reader has taken everything sent before the stall
@@ -314,7 +303,10 @@ class VirtualDevice:
                 while view and not self._stop.is_set():
                     if self._hung_up():
                         return  # the reader has gone (its capture ended): nobody to send to
-                    if select.select([], [self._master], [], 0.2)[1]:
+                    readable, writable, _ = select.select(self._listen(), [self._master], [], 0.2)
+                    if readable:
+                        self._take_input()
+                    if writable:
                         n = os.write(self._master, view)
                         view = view[n:]
                         self.sent += n
@@ -333,12 +325,26 @@ class VirtualDevice:
         poll.register(self._master, select.POLLHUP)
         return bool(poll.poll(timeout_ms))
 
+    def _listen(self) -> list[int]:
+        return [self._master] if self.answer is not None else []
+
+    def _take_input(self) -> None:
+        """Read what the host sent and send the answer (the host writes back a calibration)."""
+        try:
+            reply = self.answer(os.read(self._master, 4096))
+            if reply:
+                os.write(self._master, reply)
+        except OSError:  # the reader hung up meanwhile
+            pass
+
     def _hang_up_wait(self) -> None:
-        """Wait until the reader, having read the end-of-session marker, closes the port."""
+        """Wait until the reader, having read the end-of-session marker, closes the port; answer it meanwhile."""
         deadline = time.monotonic() + self.drain_timeout
         while not self._stop.is_set() and time.monotonic() < deadline:
             if self._hung_up(200):
                 return
+            if self._listen() and select.select(self._listen(), [], [], 0)[0]:
+                self._take_input()
 
     def _unread(self) -> int:
         """Bytes sent that the reader has not read yet (its input queue; the port is opened for a moment when

@@ -1,4 +1,4 @@
-"""gyrocal frames: the binary wire format from a device to ``gyrocal capture``.
+"""gyrocal frames: the binary wire format between a device and ``gyrocal capture``.
 
 A frame is ``A5 5A | type | length L | payload (L bytes) | CRC-16``. The CRC is
 CRC-16/CCITT-FALSE (polynomial 0x1021, initial value 0xFFFF, no reflection, no final XOR;
@@ -19,12 +19,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .write_frames import CalibrationStored, SetCalibration  # the write-back's two frames
+
 __all__ = [
     "MAX_PAYLOAD",
     "OVERHEAD",
     "SYNC",
     "TURN_LABELS",
     "Calibrated",
+    "CalibrationStored",
     "DecoderStats",
     "End",
     "Frame",
@@ -33,6 +36,7 @@ __all__ = [
     "ImuSample",
     "Result",
     "Sample",
+    "SetCalibration",
     "Text",
     "Turn",
     "crc16",
@@ -251,8 +255,8 @@ class End:
         return cls(cls.FORMAT.unpack(p)[0])
 
 
-Frame = Hello | Sample | ImuSample | Calibrated | Turn | Result | Text | End
-_FIXED = (Hello, Sample, ImuSample, Calibrated, Turn, Result, End)
+Frame = Hello | Sample | ImuSample | Calibrated | Turn | Result | Text | End | SetCalibration | CalibrationStored
+_FIXED = (Hello, Sample, ImuSample, Calibrated, Turn, Result, End, SetCalibration, CalibrationStored)
 _KINDS = {cls.TYPE: cls for cls in (*_FIXED, Text)}
 #: Fixed payload length per type (TEXT: any length up to MAX_PAYLOAD).
 _LENGTHS = {cls.TYPE: cls.FORMAT.size for cls in _FIXED}

@@ -118,6 +118,13 @@ class Capture:
         store = SampleStore(out, header_comment or self._comment)
         self.result = CaptureResult(out, store, "", None, None, DeviceLog(store))
         self._t_wall0: float | None = None
+        self.link = None  # the open port after run(keep_open=True), for the write-back
+
+    def close(self) -> None:
+        """Close the port kept open by ``run(keep_open=True)``."""
+        if self.link is not None:
+            self.link.close()
+            self.link = None
 
     def link_stats(self):
         """The decoder's counts so far (frames: CRC errors, lost samples; text: bad lines)."""
@@ -201,9 +208,11 @@ class Capture:
 
     def run(self, stop: Callable[[], bool] = lambda: False,
             each: Callable[[Capture], bool] | None = None,
-            keep_from: Callable[[], int | None] | None = None) -> CaptureResult:
+            keep_from: Callable[[], int | None] | None = None, keep_open: bool = False) -> CaptureResult:
         """Read until an end condition; `each` runs after every read and may end the capture (True);
-        `keep_from` says from which sample (absolute index) on `each` still needs the samples in memory.
+        `keep_from` says from which sample (absolute index) on `each` still needs the samples in memory;
+        `keep_open` leaves the port open in ``link`` (unless the link ended) for :meth:`close` to close:
+        reopening a USB serial port resets many boards.
 
         Whatever ends it, the file holds every sample decoded and is put in place before returning.
         """
@@ -248,7 +257,10 @@ class Capture:
                     r.store.trim(None if keep_from is None else keep_from())
                     self.on_event("progress", self)
         finally:
-            ser.close()
+            if keep_open and r.ended != "end of stream":
+                self.link = ser
+            else:
+                ser.close()
             if self._text is not None and r.ended in ("", "end of stream"):  # a line cut by the link is bad; one
                 self._text.finish()                                          # left unread on purpose is not
             r.ended = r.ended or "stopped"

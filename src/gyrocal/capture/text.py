@@ -13,11 +13,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from ..errors import InputError
 from ..io.columns import resolve, time_scale
 from .frames import End
 
-__all__ = ["END_LINE", "Reading", "TextDecoder", "TextStats"]
+__all__ = ["END_LINE", "Reading", "TextDecoder", "TextStats", "text_lines"]
 
 #: The line a device sends when the session is over (a recorded or simulated one).
 END_LINE = "# end of session"
@@ -202,3 +204,20 @@ class TextDecoder:
             self.stats.lines += 1
             self.stats.bad_lines += 1
         self._buf = bytearray()
+
+
+def text_lines(session) -> bytes:
+    """A :class:`~gyrocal.capture.simulated.DeviceSession` as an Arduino sketch prints it with ``Serial.println``:
+    ``t_us,gx,gy,gz[,temp][,ax,ay,az]``,
+    then the end-of-session line."""
+    head = "t_us,gx,gy,gz" + (",temp" if session.temp is not None else "")
+    cols = [session.t_us.astype(str), *(session.raw[:, j].astype(str) for j in range(3))]
+    if session.temp is not None:
+        cols.append(np.char.mod("%.2f", session.temp))
+    if session.accel is not None:
+        head += ",ax,ay,az"
+        cols += [session.accel[:, j].astype(str) for j in range(3)]
+    rows = cols[0]
+    for c in cols[1:]:
+        rows = np.char.add(np.char.add(rows, ","), c)
+    return (head + "\r\n" + "\r\n".join(rows.tolist()) + "\r\n" + END_LINE + "\r\n").encode()

@@ -115,6 +115,7 @@ FLAGS: dict[str, str] = {
     "hold": "--hold",
     "faults": "--faults",
     "pace": "--pace",
+    "write_back_timeout": "--write-back-timeout",
     # simulate --reference (a reference gyro's log) and verify, whose reading flags for the reference
     # carry the prefix ref_ (see cli/_reading.py: prefixed_params)
     "reference": "--reference",

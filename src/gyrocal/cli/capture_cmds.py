@@ -4,10 +4,8 @@ from __future__ import annotations
 
 import math
 import queue
-import signal
 import sys
 import threading
-import time
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Annotated
@@ -16,61 +14,12 @@ import typer
 
 from ..choices import AccelUnit, CaptureWire, GuideName, InputUnit
 from ..errors import GyrocalError, InputError
+from ._capture_progress import Progress as _Progress
+from ._capture_progress import Stop as _Stop
+from ._capture_progress import say as _say
 from ._outputs import check_output
 from ._station import StationFlags, station_flags
 from .app import app, console, warn
-
-
-class _Stop:
-    """SIGINT and SIGTERM set a flag the capture loop reads after each read: no byte read is dropped."""
-
-    def __init__(self):
-        self.requested = False
-        self._old = {}
-
-    def __enter__(self):
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            self._old[sig] = signal.signal(sig, self._handle)
-        return self
-
-    def _handle(self, signum, frame):
-        self.requested = True
-
-    def __exit__(self, *exc):
-        for sig, old in self._old.items():
-            signal.signal(sig, old)
-
-    def __call__(self) -> bool:
-        return self.requested
-
-
-class _Progress:
-    """One status line on stderr: redrawn in place on a terminal, every 10 s otherwise."""
-
-    def __init__(self, quiet: bool):
-        self.tty = sys.stderr.isatty()
-        self.quiet = quiet
-        self.last = 0.0
-
-    def show(self, line: str) -> None:
-        if self.quiet:
-            return
-        now = time.monotonic()
-        if self.tty:
-            sys.stderr.write("\r\x1b[K" + line)
-            sys.stderr.flush()
-        elif now - self.last >= 10.0:
-            sys.stderr.write(line + "\n")
-            self.last = now
-
-    def clear(self) -> None:
-        if self.tty and not self.quiet:
-            sys.stderr.write("\r\x1b[K")
-
-
-def _say(progress: _Progress, text: str) -> None:
-    progress.clear()
-    console.print(text, highlight=False, soft_wrap=True, markup=False)
 
 
 def _keys(commands: queue.Queue) -> None:
@@ -216,6 +165,11 @@ def capture(
     next_unit: Annotated[bool, typer.Option("--next", help="After each unit, ask for the next serial (typed, or "
         "from a barcode scanner) and capture again, until an empty line or Ctrl-C; -o and --cal take {serial}.",
         rich_help_panel="Production station")] = False,
+    write_back: Annotated[bool, typer.Option("--write-back", help="After a pass (or without --limits), send the "
+        "calibration to the device (gyrocal frames) and check what it reads back from its storage; a failed unit is "
+        "never written (default: off).", rich_help_panel="Production station")] = False,
+    write_back_timeout: Annotated[float, typer.Option("--write-back-timeout", help="Longest wait for the device's "
+        "answer to --write-back [s].", rich_help_panel="Production station")] = 5.0,
     flags: StationFlags = StationFlags(),
 ) -> None:
     """Record a live stream from a serial port; with --guide, walk through a calibration and calibrate."""
@@ -226,9 +180,13 @@ def capture(
     if next_unit and (guide is None or flags.unit is None or "{serial}" not in str(output)):
         raise InputError("--next captures unit after unit: give --guide, the first --unit SERIAL, and an -o whose "
                          "name holds {serial} (for example -o 'runs/{serial}.csv')")
+    if write_back and (guide not in ("servo", "hand") or not write_back_timeout > 0):
+        raise InputError("--write-back sends the gyro correction of a guided servo or hand session: give --guide "
+                         "servo (and a --write-back-timeout > 0)")
     session = dict(port=port, baud=baud, wire=wire, columns=columns, duration=duration, samples=samples,
                    silence=silence, guide=guide, speed=speed, poses=poses, hold=hold, force=force, quiet=quiet,
-                   reading=_ReadAs(units, sensitivity, sample_rate, accel_units, accel_sensitivity))
+                   reading=_ReadAs(units, sensitivity, sample_rate, accel_units, accel_sensitivity),
+                   write_back=write_back_timeout if write_back else None)
     failed = False
     while True:
         serial = flags.unit or ""
@@ -254,7 +212,7 @@ def _next_serial() -> str | None:
 
 
 def _one_unit(output: Path, calibration: Path | None, flags: StationFlags, *, port, baud, wire, columns, duration,
-              samples, silence, guide, speed, poses, hold, force, quiet, reading) -> str | None:
+              samples, silence, guide, speed, poses, hold, force, quiet, reading, write_back) -> str | None:
     """Capture (and with a guide, calibrate, accept and store) one unit; its verdict."""
     from ..capture.recorder import Capture
     from ..io import check_csv_name
@@ -270,11 +228,18 @@ def _one_unit(output: Path, calibration: Path | None, flags: StationFlags, *, po
         guided = None if guide is None else _Guided(guide, speed_rad, reading, progress, stop, poses=poses, hold=hold)
         cap = Capture(port, output, baud=baud, wire=wire, columns=columns, duration=duration, samples=samples,
                       silence=silence, on_event=_on_event(progress, reading.units))
-        result = cap.run(stop=stop, each=guided, keep_from=None if guided is None else guided.keep_from)
+        result = cap.run(stop=stop, each=guided, keep_from=None if guided is None else guided.keep_from,
+                         keep_open=write_back is not None)
         if guided is not None and not guided.guide.complete:
             guided(cap, force=True)  # the last samples, read after the last look
     progress.clear()
-    return _finish(result, port, reading, guided, cal_path, speed_rad, flags)
+    try:
+        from ._write_back import WriteBack
+
+        send = None if write_back is None else WriteBack(cap.link, result.wire, write_back, result.hello)
+        return _finish(result, port, reading, guided, cal_path, speed_rad, flags, send)
+    finally:
+        cap.close()
 
 
 @dataclass(frozen=True)
@@ -295,7 +260,7 @@ class _ReadAs:
                        accel_sensitivity=self.accel_sensitivity or hello.accel_sensitivity)
 
 
-def _finish(result, port, reading: _ReadAs, guided, cal_path, speed_rad, flags: StationFlags) -> str | None:
+def _finish(result, port, reading: _ReadAs, guided, cal_path, speed_rad, flags: StationFlags, send) -> str | None:
     from ..capture.report import calibrate_capture, summary
 
     if result.path is None:
@@ -311,7 +276,7 @@ def _finish(result, port, reading: _ReadAs, guided, cal_path, speed_rad, flags: 
         doc, verdict = _calibrate_imu(result.path, reading, guided.guide.windows(), cal_path, flags)
     elif guided is not None and guided.guide.complete:
         run = calibrate_capture(result.path, windows=guided.guide.windows(), speed=speed_rad, **calibrate_args)
-        doc, verdict = _station_result(run.calibration, cal_path, flags, result.path, "calibration")
+        doc, verdict = _station_result(run.calibration, cal_path, flags, result.path, "calibration", send)
         console.print(run.report(), highlight=False, soft_wrap=True, markup=False)
         console.print(f"wrote {cal_path}", highlight=False, markup=False)
     elif guided is not None:
@@ -330,14 +295,21 @@ def _finish(result, port, reading: _ReadAs, guided, cal_path, speed_rad, flags: 
     return verdict
 
 
-def _station_result(cal, cal_path: Path, flags: StationFlags, recording: Path, kind: str) -> tuple[dict, str | None]:
-    """The calibration file with the unit and its acceptance, written and stored; the document and verdict."""
+def _station_result(cal, cal_path: Path, flags: StationFlags, recording: Path, kind: str,
+                    send=None) -> tuple[dict, str | None]:
+    """The calibration file with the unit and its acceptance (and with `send`, written back to the device after a
+    pass), written and stored; the document and verdict. A failed write-back is refused once both are written."""
     from ._station import finish, write_and_store
 
     doc, verdict = finish(cal.to_document(), flags, inputs=(recording,))
+    refusal = None
+    if send is not None and verdict in (None, "pass"):
+        doc, refusal = send(cal, doc)
     record = write_and_store(doc, flags, cal_path, verdict, inputs=(recording,), kind=kind, job="capture")
     if record is not None:
         console.print(f"stored as record {record} in {flags.store}", highlight=False)
+    if refusal is not None:
+        raise refusal
     return doc, verdict
 
 
