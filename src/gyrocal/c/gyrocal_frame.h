@@ -87,6 +87,7 @@ typedef struct {
 #define GYROCAL_TURN_WRONG_ANGLE 1u
 #define GYROCAL_TURN_OFF_AXIS 2u
 #define GYROCAL_TURN_TOO_LONG 3u
+#define GYROCAL_TURN_BAD_WINDOW 4u /* the accumulator refused the window (gyrocal_accum_finish) */
 
 /* CRC-16/CCITT-FALSE of n bytes, continuing from crc (start with 0xFFFF). */
 uint16_t gyrocal_crc16(const uint8_t *data, size_t n, uint16_t crc);
