@@ -72,6 +72,8 @@ class Turn:
     ripple: float = 0.0  # relative speed ripple on the cruise
     ripple_hz: float = 2.5
     jitter_deg: float = 0.0  # servo vibration: a smooth random angle error [deg rms], band-limited to 8 Hz
+    plateau_ripple: float = 0.0  # relative sinusoidal speed ripple on the cruise only, zero mean over it
+    plateau_ripple_hz: float = 2.5
     wobble_deg: float = 0.0  # wobble of the axis about a perpendicular one [deg]
     wobble_hz: float = 1.5
     calibration: bool = True  # part of the calibration (in the windows file)
@@ -187,6 +189,11 @@ def _profile(turn: Turn, fs: float, rng: np.random.Generator) -> np.ndarray:
         b, a = butter(2, 8.0 / (fs / 2))
         e = lfilter(b, a, rng.normal(size=len(t)))
         ang += turn.jitter_deg * e / e.std() * taper
+    if turn.plateau_ripple:  # on the cruise [tr, dur - tr] only; its angle is zero at both ends
+        phase, w, span = rng.uniform(0, 2 * np.pi), 2 * np.pi * turn.plateau_ripple_hz, cruise
+        tau = np.clip(t - tr, 0.0, span)
+        mean = (np.cos(phase) - np.cos(w * span + phase)) / (w * span)
+        ang += turn.plateau_ripple * v * ((np.cos(phase) - np.cos(w * tau + phase)) / w - mean * tau)
     return ang
 
 

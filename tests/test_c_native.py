@@ -58,3 +58,51 @@ def test_status_codes_agree_between_c_and_python():
     assert {k: v for k, v in codes.items() if k} == {k: name for k, (name, _) in STATUS.items()}
     assert all(issubclass(cls, GyrocalError) for _, cls in STATUS.values())
     assert {k: v for k, v in STATUS_NAMES.items() if k in codes} == codes
+
+
+def _mirrors() -> dict:
+    """The ctypes mirrors of the C structs, by C type name."""
+    from gyrocal.capture import c_device as cd
+    from gyrocal.firmware import host
+
+    return {"gyrocal_hello_t": cd._Hello, "gyrocal_turn_t": cd._Turn, "gyrocal_accum_t": cd._Accum,
+            "gyrocal_obs_t": cd._Obs, "gyrocal_scale_bias_t": cd._ScaleBias, "gyrocal_session_t": cd._Session,
+            "gyrocal_affine_t": host._Affine, "gyrocal_imu_t": host._Imu, "gyrocal_thermal_t": host._Thermal,
+            "host gyrocal_accum_t": host._Accum, "host gyrocal_obs_t": host._Obs,
+            "host gyrocal_scale_bias_t": host._ScaleBias}
+
+
+def test_ctypes_mirrors_match_the_headers(tmp_path):
+    """Reference: the host compiler's sizeof and offsetof of every mirrored struct and field (a probe built
+    from the headers), and the headers' GYROCAL_FRAME_MAX and GYROCAL_TURN_* codes."""
+    import ctypes
+
+    from gyrocal.capture import c_device as cd
+    from gyrocal.capture import frames
+
+    lines, want = [], {}
+    for key, cls in _mirrors().items():
+        ctype = key.split()[-1]
+        lines.append(f'printf("{key} %zu\\n", sizeof({ctype}));')
+        want[key] = ctypes.sizeof(cls)
+        for name, *_ in cls._fields_:
+            lines.append(f'printf("{key}.{name} %zu\\n", offsetof({ctype}, {name}));')
+            want[f"{key}.{name}"] = getattr(cls, name).offset
+    lines.append('printf("FRAME_MAX %u\\n", (unsigned)GYROCAL_FRAME_MAX);')
+    want["FRAME_MAX"] = ctypes.sizeof(cd._BUF)
+    probe = tmp_path / "probe.c"
+    probe.write_text('#include <stddef.h>\n#include <stdio.h>\n#include "gyrocal_session.h"\nint main(void)\n{\n'
+                     + "\n".join(lines) + "\nreturn 0;\n}\n")
+    exe = tmp_path / "probe"
+    build = subprocess.run([_compiler(), *FLAGS, f"-I{c_source_dir()}", str(probe), "-o", str(exe)],
+                           capture_output=True, text=True, check=False)
+    assert build.returncode == 0, build.stderr
+    out = subprocess.run([str(exe)], capture_output=True, text=True, check=True).stdout.split("\n")
+    got = {key: int(value) for key, value in (line.rsplit(" ", 1) for line in out if line)}
+    assert got == want
+    header = (c_source_dir() / "gyrocal_frame.h").read_text()
+    codes = {int(v): name for name, v in re.findall(r"#define GYROCAL_TURN_(\w+) (\d+)u", header)}
+    assert sorted(codes) == list(range(len(cd._REASONS))) and codes[0] == "ACCEPTED"
+    assert {k: v.upper().replace(" ", "_") for k, v in frames._TURN_REASONS.items()} == \
+        {k: v for k, v in codes.items() if k} == {k: r.split(": ")[1].upper().replace(" ", "_")
+                                                  for k, r in enumerate(cd._REASONS) if k}

@@ -223,3 +223,16 @@ def test_a_gap_inside_a_plateau_keeps_the_ripple_in_phase(tmp_path):
     assert 1.0 <= np.median(ratio) < 1.5
     assert np.max(np.abs(z)) < 3.5
     assert abs(_rms(z) - 1) < 4 / math.sqrt(2 * np.size(z)), _rms(z)  # two-sided; measured 1.07
+
+
+def test_the_generators_plateau_ripple_has_zero_mean_over_the_true_plateau():
+    """The plateau-only ripple of issue 22 item 8 (``Turn.plateau_ripple``), on a noise-free, unmounted gyro.
+    Reference: the turn's own parameters (60 deg/s cruise between 0.3 s ramps, 5 % at 2.5 Hz)."""
+    gyro = R.Gyro(mount_deg=0.0, cross=0.0, noise_density=0.0, flicker=0.0, lsb=None, dlpf_hz=None,
+                  offset=(0.0, 0.0, 0.0))
+    turn = R.Turn((1, 0, 0), 360.0, 60.0, profile="trapezoid", accel=200.0, plateau_ripple=0.05)
+    log = R.record([turn], gyro, rate=1000.0, stamps="sensor", seed=3, earth=False)
+    t0 = log.turns[0]["start"]
+    cruise = log.gyro[int(round((t0 + 0.3) * 1000)) + 2: int(round((t0 + 6.0) * 1000)) - 2, 0]
+    assert abs(cruise.mean() - 60.0) < 0.01 and 2.9 < (cruise.max() - cruise.min()) / 2 < 3.1
+    assert abs(log.gyro[:, 0].sum() / 1000 - 360.0) < 0.05  # the turn still turns its angle

@@ -45,12 +45,12 @@ void example_setup(example_t *ex, float sample_rate, float sensitivity, uint16_t
 static void report(example_t *ex, unsigned events)
 {
     static const char *const labels[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
-    static const char *const reasons[4] = {" accepted", " ignored: wrong angle", " ignored: off axis",
-                                           " ignored: too long"};
+    static const char *const reasons[5] = {" accepted", " ignored: wrong angle", " ignored: off axis",
+                                           " ignored: too long", " ignored: bad window"};
     gyrocal_session_t *s = &ex->session;
     if (events & GYROCAL_SESSION_TURN) {
         board_write(ex->frame, gyrocal_frame_turn(ex->frame, &s->turn));
-        send_text(ex, labels[s->turn.slot], reasons[s->turn.status < 4u ? s->turn.status : 1u]);
+        send_text(ex, labels[s->turn.slot], reasons[s->turn.status < 5u ? s->turn.status : 1u]);
     }
     if (events & GYROCAL_SESSION_RESULT) {
         board_write(ex->frame, gyrocal_frame_result(ex->frame, s->status, GYROCAL_METHOD_FIRST_MOMENT,

@@ -3,8 +3,8 @@
  * tests/test_c_native.py with -fsanitize=address,undefined.
  *
  * References: the CRC-16/CCITT-FALSE check value 0x29B1 of "123456789" (the CRC catalogue's), a sample
- * frame, a 6-axis (IMU) frame and an end frame written out by hand from docs/capture.md's byte tables, and a noise-free six-turn session built
- * from a known k and b, which the session must find to float32 precision.
+ * frame, a 6-axis (IMU) frame and an end frame written out by hand from docs/capture.md's byte tables, and noise-free six-turn
+ * sessions (200 Hz, and 1 kHz with 1 s ramps) built from a known k and b, which the session must find to the readings' rounding.
  * Exit status: the number of failed checks (0 = all passed).
  */
 #include "gyrocal_frame.h"
@@ -91,22 +91,38 @@ static void reading(const float k[3], const float b[3], int axis, float w, int16
     }
 }
 
-static void test_session_finds_the_six_turns(void)
+/* Rate [deg/s] n samples into a turn of ramp_n samples up, plateau_n at w, ramp_n down (0 after it). */
+static float profile(int n, int ramp_n, int plateau_n, float w)
+{
+    if (n < ramp_n) {
+        return w * ((float)n + 0.5f) / (float)ramp_n;
+    }
+    if (n < ramp_n + plateau_n) {
+        return w;
+    }
+    n -= ramp_n + plateau_n;
+    return n < ramp_n ? w * ((float)(ramp_n - n) - 0.5f) / (float)ramp_n : 0.0f;
+}
+
+/* The six turns at 60 deg/s (360 deg each, with ramp_s ramps) and 3 s still between, at fs [Hz]:
+ * every turn accepted, one result, and k, b of the noise-free readings to rounding. */
+static void six_turns(float fs, float ramp_s)
 {
     static gyrocal_session_t s;
     const float k[3] = {1.0f / 131.0f, 1.02f / 131.0f, 0.98f / 131.0f}; /* deg/s per count */
     const float b[3] = {200.0f, -150.0f, 80.0f};                        /* counts */
+    const int ramp_n = (int)(ramp_s * fs + 0.5f), plateau_n = (int)((6.0f - ramp_s) * fs + 0.5f);
     int16_t raw[3];
     unsigned events, turns = 0u, results = 0u;
     int turn, n;
-    CHECK(gyrocal_session_init(&s, 200.0f, 131.0f, 360.0f) == GYROCAL_OK);
-    for (n = 0; n < 400; ++n) { /* 2 s still */
+    CHECK(gyrocal_session_init(&s, fs, 131.0f, 360.0f) == GYROCAL_OK);
+    for (n = 0; n < (int)(2.0f * fs); ++n) { /* 2 s still */
         reading(k, b, 0, 0.0f, raw);
         gyrocal_session_add(&s, raw);
     }
     for (turn = 0; turn < 6; ++turn) {
-        for (n = 0; n < 1200 + 600; ++n) { /* 6 s at 60 deg/s: 360 deg, then 3 s still */
-            reading(k, b, turn / 2, n < 1200 ? ((turn % 2) ? -60.0f : 60.0f) : 0.0f, raw);
+        for (n = 0; n < 2 * ramp_n + plateau_n + (int)(3.0f * fs); ++n) {
+            reading(k, b, turn / 2, profile(n, ramp_n, plateau_n, (turn % 2) ? -60.0f : 60.0f), raw);
             events = gyrocal_session_add(&s, raw);
             if (events & GYROCAL_SESSION_TURN) {
                 ++turns;
@@ -116,7 +132,8 @@ static void test_session_finds_the_six_turns(void)
         }
     }
     CHECK(turns == 6u && results == 1u && s.status == GYROCAL_OK);
-    /* rounding the readings to counts moves k by about 0.5 / 7860 at most */
+    /* rounding the readings to counts moves k by about 0.5 / 7860 at most; a window that missed the
+     * ramp under the 10 deg/s band (about 0.5 deg of 360 at 1 kHz with 1 s ramps) moves it by 1.5e-3 */
     for (n = 0; n < 3; ++n) {
         CHECK(fabsf(s.result.k[n] / k[n] - 1.0f) < 2e-4f);
         CHECK(fabsf(s.result.b[n] - b[n]) < 1.0f);
@@ -180,6 +197,25 @@ static void test_set_calibration_round_trip(void)
     CHECK(gyrocal_frame_set_calibration(out, 0) == 0u && gyrocal_frame_rx_byte(0, 0xA5u) == 0u);
 }
 
+static void test_session_finds_the_six_turns(void)
+{
+    six_turns(200.0f, 0.0f);
+    six_turns(200.0f, 0.3f);
+    six_turns(1000.0f, 1.0f); /* slow ramps at a high rate: the window before the start is sized in time */
+}
+
+static void test_session_at_a_low_rate(void)
+{
+    static gyrocal_session_t s;
+    const int16_t raw[3] = {1, 2, 3};
+    int n;
+    CHECK(gyrocal_session_init(&s, 1.0f, 131.0f, 360.0f) == GYROCAL_OK);
+    for (n = 0; n < 3; ++n) {
+        gyrocal_session_add(&s, raw);
+    }
+    CHECK(s.phase == 1u && s.base[0] == 1.0f && s.base[2] == 3.0f); /* settled on two samples, not one */
+}
+
 int main(void)
 {
     test_crc_and_sample_frame();
@@ -187,5 +223,6 @@ int main(void)
     test_null_and_limits();
     test_session_finds_the_six_turns();
     test_set_calibration_round_trip();
+    test_session_at_a_low_rate();
     return failures;
 }

@@ -93,6 +93,7 @@ typedef struct {
 #define GYROCAL_TURN_WRONG_ANGLE 1u
 #define GYROCAL_TURN_OFF_AXIS 2u
 #define GYROCAL_TURN_TOO_LONG 3u
+#define GYROCAL_TURN_BAD_WINDOW 4u /* the accumulator refused the window (gyrocal_accum_finish) */
 
 /* A correction sent by the host (GYROCAL_FRAME_SET_CALIBRATION) and echoed by the device, as it read it back
  * from its storage (GYROCAL_FRAME_CALIBRATION_STORED): w = cal.matrix (raw - cal.offset), raw and offset in

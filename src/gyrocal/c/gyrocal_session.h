@@ -3,9 +3,9 @@
  * (part of gyrocal, MIT licence).
  *
  * Feed every raw sample [counts] to gyrocal_session_add. The session learns the standstill reading,
- * finds each whole turn (from the moment the rate leaves the standstill band, with GYROCAL_SESSION_PRE
- * samples before it, to GYROCAL_SESSION_QUIET_S of standstill after it), reduces it with the window
- * accumulator and files it by axis and sense (+x, -x, +y, -y, +z, -z); a later turn of the same slot
+ * finds each whole turn (from the moment the rate leaves the standstill band, with GYROCAL_SESSION_PRE_S
+ * to twice that of standstill before it, to GYROCAL_SESSION_QUIET_S of standstill after it), reduces it
+ * with the window accumulator and files it by axis and sense (+x, -x, +y, -y, +z, -z); a later turn of the same slot
  * replaces an earlier one. Once all six slots are filled it calibrates with the first-moment estimator
  * (gyrocal_first_moment) and again after every later accepted turn.
  *
@@ -13,7 +13,12 @@
  * so the windows are whole turns and static margins inside them cost noise, not bias. Rates are in
  * deg/s throughout; k comes out in deg/s per count and b in counts.
  *
- * C99, float32, no dynamic memory, no static data; about 560 bytes of state.
+ * The window before the start is sized in time, not in samples, so that the part of a slow ramp
+ * under the band is inside it at any sample rate: two window accumulators run while still, restarted
+ * in turn every GYROCAL_SESSION_PRE_S, and the older one becomes the turn's window. A window never
+ * reaches back past the end of the previous turn.
+ *
+ * C99, float32, no dynamic memory, no static data; about 450 bytes of state.
  */
 #ifndef GYROCAL_SESSION_H
 #define GYROCAL_SESSION_H
@@ -27,8 +32,8 @@
 extern "C" {
 #endif
 
-#ifndef GYROCAL_SESSION_PRE
-#define GYROCAL_SESSION_PRE 32 /* samples kept before a detected start: the part of the ramp under the band */
+#ifndef GYROCAL_SESSION_PRE_S
+#define GYROCAL_SESSION_PRE_S 0.5f /* [s] kept before a detected start (up to twice that): the ramp under the band */
 #endif
 #define GYROCAL_SESSION_THRESHOLD_DEG_S 10.0f /* rate off the standstill reading that counts as turning */
 #define GYROCAL_SESSION_SETTLE_S 0.5f         /* standstill at power-up that gives the first standstill reading */
@@ -49,16 +54,17 @@ typedef struct {
     float turn_angle;   /* angle of every turn [deg] */
     float threshold;    /* [counts] */
     uint32_t settle_n, quiet_n, max_n;
+    uint32_t pre_n;     /* GYROCAL_SESSION_PRE_S in samples */
     /* state */
     uint32_t seq;       /* samples seen so far */
     uint8_t phase;      /* 0 settling, 1 still, 2 turning */
     uint8_t have;       /* bit i: slot i holds an accepted turn */
-    uint16_t ring_pos, ring_len;
-    int16_t ring[GYROCAL_SESSION_PRE][3];
+    uint8_t cur;        /* acc[cur] is the window of the turn under way */
+    uint32_t still;     /* still samples since acc[0] restarted, modulo 2 pre_n (acc[1] restarts at pre_n) */
+    uint32_t run;       /* samples in a row above the band (still) or inside it (turning) */
     float base[3];      /* standstill reading [counts] */
-    float sum[3];       /* sum of (reading - base) over the turn [counts] */
-    uint32_t start, run;
-    gyrocal_accum_t acc;
+    float pre_base[2][3]; /* the standstill reading when acc[0], acc[1] restarted */
+    gyrocal_accum_t acc[2];
     gyrocal_obs_t obs[GYROCAL_N_OBS];
     /* outputs */
     gyrocal_turn_t turn;

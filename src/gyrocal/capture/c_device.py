@@ -21,8 +21,7 @@ __all__ = ["CDevice", "CStorage", "firmware_stream"]
 
 _F3 = ctypes.c_float * 3
 _BUF = ctypes.c_uint8 * 70  # GYROCAL_FRAME_MAX
-_PRE = 32  # GYROCAL_SESSION_PRE
-_REASONS = (" accepted", " ignored: wrong angle", " ignored: off axis", " ignored: too long")
+_REASONS = (" accepted", " ignored: wrong angle", " ignored: off axis", " ignored: too long", " ignored: bad window")
 
 
 class _Hello(ctypes.Structure):
@@ -54,10 +53,9 @@ class _Session(ctypes.Structure):
     _fields_ = [
         ("sample_rate", ctypes.c_float), ("sensitivity", ctypes.c_float), ("turn_angle", ctypes.c_float),
         ("threshold", ctypes.c_float), ("settle_n", ctypes.c_uint32), ("quiet_n", ctypes.c_uint32),
-        ("max_n", ctypes.c_uint32), ("seq", ctypes.c_uint32), ("phase", ctypes.c_uint8), ("have", ctypes.c_uint8),
-        ("ring_pos", ctypes.c_uint16), ("ring_len", ctypes.c_uint16), ("ring", (ctypes.c_int16 * 3) * _PRE),
-        ("base", _F3), ("sum", _F3), ("start", ctypes.c_uint32), ("run", ctypes.c_uint32), ("acc", _Accum),
-        ("obs", _Obs * 6), ("turn", _Turn), ("result", _ScaleBias), ("status", ctypes.c_int),
+        ("max_n", ctypes.c_uint32), ("pre_n", ctypes.c_uint32), ("seq", ctypes.c_uint32), ("phase", ctypes.c_uint8),
+        ("have", ctypes.c_uint8), ("cur", ctypes.c_uint8), ("still", ctypes.c_uint32), ("run", ctypes.c_uint32),
+        ("base", _F3), ("pre_base", _F3 * 2), ("acc", _Accum * 2), ("obs", _Obs * 6), ("turn", _Turn), ("result", _ScaleBias), ("status", ctypes.c_int),
         ("iterations", ctypes.c_int),
     ]
 
@@ -161,7 +159,7 @@ class CDevice:
         out = b""
         if events & 1:
             out += self._out(self.dll.gyrocal_frame_turn(self._buf, ctypes.byref(s.turn)))
-            out += self.text(TURN_LABELS[s.turn.slot] + _REASONS[s.turn.status if s.turn.status < 4 else 1])
+            out += self.text(TURN_LABELS[s.turn.slot] + _REASONS[s.turn.status if s.turn.status < 5 else 1])
         if events & 2:
             ok = s.status == 0
             out += self._out(self.dll.gyrocal_frame_result(self._buf, s.status, 0, s.iterations, 6,

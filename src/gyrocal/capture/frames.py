@@ -52,7 +52,7 @@ TEMP_NONE = -32768  # temperature field of a device without a thermometer
 TURN_LABELS = ("+x", "-x", "+y", "-y", "+z", "-z")
 _UNITS = ("rad/s", "deg/s")
 _METHODS = ("first-moment", "algorithm1")
-_TURN_REASONS = {1: "wrong angle", 2: "off axis", 3: "too long"}
+_TURN_REASONS = {1: "wrong angle", 2: "off axis", 3: "too long", 4: "bad window"}
 #: gyrocal_status_t (gyrocal_cal.h) by code.
 STATUS_NAMES = {0: "GYROCAL_OK", 1: "GYROCAL_E_INPUT", 2: "GYROCAL_E_SINGULAR", 3: "GYROCAL_E_NONPHYSICAL",
                 4: "GYROCAL_E_NOCONV", 5: "GYROCAL_E_RANGE"}
