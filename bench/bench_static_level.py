@@ -4,8 +4,8 @@ Run by hand:  python bench/bench_static_level.py [--samples 1000000] [--rate 200
 
 ``segmentation._motion.static_level`` clusters the quiet 0.25 s blocks of a recording by their
 mean. The naive way (and this module's way before) compares every pair of up to ~4,000 blocks
-in one ``q x q`` distance matrix; now at most 800 blocks, evenly spread, are compared 256 rows at
-a time. Both run here on the same simulated servo session (the servo method of Wang et al.:
+in one ``q x q`` distance matrix; now the quiet blocks at the noise floor nearest zero, at most
+800, are compared 256 rows at a time. Both run here on the same simulated servo session (the servo method of Wang et al.:
 six turns, repeated), with the peak memory traced (``tracemalloc``) and the best time of 3.
 """
 

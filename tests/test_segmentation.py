@@ -229,3 +229,24 @@ def test_real_session_calibrates_alike_from_detected_or_listed_windows(ferraris)
     np.testing.assert_allclose(ka, kg, rtol=1e-3)
     np.testing.assert_allclose(np.degrees(auto.fit.model.b), np.degrees(given.fit.model.b), atol=0.01)
     assert auto.calibration.input_units == "deg/s" and "kx" in auto.report()
+
+
+@pytest.mark.parametrize("vibration", [0.05, 0.0])
+def test_long_log_with_a_tiny_share_of_rest_calibrates(vibration):
+    """139 revolutions per turn, 3 s waits: rest is 0.4 % of the log, as in a 5 M-sample servo log at 1 kHz.
+
+    The standstill level once came out as a rotation plateau (about 60 deg/s off) and no turn about
+    two axes was found; a vibration-free servo's plateaus are as quiet as rest, so both are tried.
+    """
+    rec, truth = simulate_servo(GYRO, ServoProtocol(revolutions=139, vibration=vibration, misalignment_deg=5.0),
+                                sample_rate=100.0, rng=np.random.default_rng(3))
+    rest = np.concatenate([rec.gyro[w.start:w.stop] for w in truth.windows if w.kind == "static"])
+    assert len(rest) < 0.005 * len(rec)
+    run = calibrate(rec, speed=SPEED)
+    assert [w.label for w in run.segmentation.rotations] == list(PAPER_TURNS)
+    # the median of the quiet blocks' means against the mean of all rest: 6 sigma, half the rest in whole blocks
+    tol = 6 * 1.6 * GYRO.noise_std / math.sqrt(len(rest) / 2)
+    np.testing.assert_allclose(run.segmentation.baseline, rest.mean(axis=0), atol=tol)
+    np.testing.assert_allclose(gyrocal.segmentation.standstill_level(rec), rest.mean(axis=0), atol=tol)
+    np.testing.assert_allclose(run.fit.model.k, MPU9250.k, rtol=1e-3)
+    np.testing.assert_allclose(run.fit.model.b, MPU9250.b, atol=1e-3)

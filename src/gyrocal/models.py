@@ -22,7 +22,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ._arrays import readonly
+from ._arrays import readonly, rows_times
 from ._validation import finite_array, vector3
 from .errors import InputError, NonPhysicalEstimateError
 
@@ -57,7 +57,7 @@ def kb_to_kg(K, B) -> np.ndarray:
 def correct(matrix: np.ndarray, offset: np.ndarray, readings) -> np.ndarray:
     """Apply ``w_true = matrix @ (m - offset)`` to readings of shape (..., 3) [reading units]."""
     m = finite_array("readings", readings, shape_tail=(3,))
-    return (m - offset) @ np.asarray(matrix).T
+    return rows_times(m - offset, matrix)
 
 
 @dataclass(frozen=True)
@@ -199,7 +199,7 @@ class Affine:
     def distort(self, true_rates) -> np.ndarray:
         """Readings for `true_rates` (noise-free): ``K w~ + B``."""
         w = finite_array("true_rates", true_rates, shape_tail=(3,))
-        return w @ self.K.T + self.B
+        return rows_times(w, self.K) + self.B
 
     def to_affine(self) -> Affine:
         return self

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import quaternion as quat
+from .._arrays import rows_times
 
 __all__ = ["EARTH_RATE", "GyroProblem", "Turn", "build_problem"]
 
@@ -89,8 +90,8 @@ class GyroProblem:
         """Corrected rates of the concatenated motion samples [rad/s]."""
         m = self.m_cat - b
         if g is not None:
-            m = m - self.f_cat @ g.T
-        return m @ a.T
+            m -= rows_times(self.f_cat, g)
+        return rows_times(m, a)
 
     def pair_integrals(self, b) -> np.ndarray:
         """Trapezoid integral of ``m - b`` over each pair's motion (P, 3) [raw s]."""

@@ -28,6 +28,7 @@ from typing import Literal, get_args
 import numpy as np
 from scipy.optimize import least_squares
 
+from .._arrays import rows_times
 from .._validation import finite_array, positive
 from ..errors import DegenerateDesignError, InputError
 from ..units import STANDARD_GRAVITY
@@ -130,7 +131,7 @@ class AccelFit:
 
     def correct(self, readings) -> np.ndarray:
         """Specific force (..., 3) [m/s^2] from readings (..., 3) [reading units]."""
-        return (np.asarray(readings, dtype=float) - self.offset) @ self.matrix.T
+        return rows_times(np.asarray(readings, dtype=float) - self.offset, self.matrix)
 
     def sensor_axes(self) -> dict[str, tuple[float, float]]:
         """Frame-free figures with 1-sigma: sensitivity of each axis and the angles between axes.

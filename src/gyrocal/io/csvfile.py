@@ -1,7 +1,8 @@
 """Delimited text recordings (CSV, TSV, whitespace), read column by column.
 
-Large files go through ``pyarrow.csv`` (multithreaded, columnar); without pyarrow, or
-for whitespace-separated files, a pure-Python reader does the same job more slowly.
+Large files go through ``pyarrow.csv`` (multithreaded, columnar), whitespace-separated ones through
+pyarrow's compute kernels (:mod:`._spaced`); without pyarrow a pure-Python reader does the same job
+more slowly.
 """
 
 from __future__ import annotations
@@ -143,9 +144,11 @@ def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool
         except ImportError:
             use_pyarrow = False
     try:
-        if use_pyarrow and layout.delimiter is not WHITESPACE and len(set(names)) == len(names):
-            cols = _read_arrow(path, packed, layout, mapping, encoding)
-        else:
+        cols = None
+        if use_pyarrow and len(set(names)) == len(names):
+            read = _read_arrow if layout.delimiter is not WHITESPACE else _read_spaced
+            cols = read(path, packed, layout, mapping, encoding)
+        if cols is None:
             cols = _read_python(path, packed, layout, encoding)
     except _DECOMPRESS_ERRORS as exc:
         raise InputError(f"{path.name}: cannot decompress it as {packed} ({exc})") from None
@@ -217,6 +220,21 @@ def _read_arrow(path: Path, packed: str | None, layout: Layout, mapping: dict, e
         raise InputError(f"{path.name}: cannot parse the table")
     cols = _joined(pieces, [mapping[c] for c in ("gx", "gy", "gz")], axis)
     pa.default_memory_pool().release_unused()  # pyarrow's allocator keeps freed blocks; the rest of the run needs them
+    return cols
+
+
+def _read_spaced(path: Path, packed: str | None, layout: Layout, mapping: dict, encoding: str) -> dict | None:
+    """Columns of a whitespace-separated table through pyarrow; None where it cannot read the lines."""
+    import pyarrow as pa
+
+    from ._spaced import spaced_pieces
+
+    pieces = spaced_pieces(path, packed, layout, [mapping[c] for c in NUMERIC if c in mapping], mapping.get("axis"),
+                           encoding)
+    if pieces is None:
+        return None
+    cols = _joined(pieces, [mapping[c] for c in ("gx", "gy", "gz")], mapping.get("axis"))
+    pa.default_memory_pool().release_unused()
     return cols
 
 

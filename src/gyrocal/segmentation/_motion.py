@@ -14,8 +14,8 @@ import numpy as np
 __all__ = ["Motion", "detect_motion", "runs_of", "static_level"]
 
 _MAX_STATS = 1_000_000  # samples enough for a quantile; more only costs time
-_MAX_CLUSTER = 800  # quiet blocks compared pairwise (spread over the session; their median is the level)
-_MAX_BLOCK_SAMPLES = 250_000  # spread evenly over the session for the static level
+_MAX_CLUSTER = 800  # quiet blocks compared pairwise (those nearest zero, where standstill is)
+_FLOOR_BLOCKS = 8  # the noise floor is the spread of the 8th quietest block (2 s of rest at 0.25 s blocks)
 
 
 @dataclass(frozen=True)
@@ -133,33 +133,62 @@ def _neighbours(points: np.ndarray, radius: float, chunk: int = 256):
     return count, lambda i: np.flatnonzero(near(slice(i, i + 1))[0])
 
 
+def _block_stats(gyro: np.ndarray, block: int, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Mean and standard deviation (n, 3) of each of the `n` whole blocks, axis by axis.
+
+    Every block counts: a stride over blocks steps over whole waits of a long log. Axis by axis on
+    views, so a column-major log is not copied.
+    """
+    mean, std = np.empty((n, 3)), np.empty((n, 3))
+    for k in range(3):
+        col = gyro[: n * block, k].reshape(n, block)
+        mean[:, k] = col.sum(axis=1) / block
+        std[:, k] = np.einsum("ij,ij->i", col, col) / block
+    np.sqrt(np.maximum(std - mean**2, 0.0), out=std)
+    return mean, std
+
+
+def _quiet_blocks(std: np.ndarray) -> np.ndarray:
+    """Indices of the blocks whose spread is at the noise floor: within 2x of the quietest few.
+
+    The floor is the `_FLOOR_BLOCKS`-th quietest block, not a share of all blocks: rest may be a tiny
+    share of a long log. Blocks frozen on an axis (saturation, repeated samples) sit below any noise
+    and would set a floor no standstill reaches, so they do not set it (they may still be quiet).
+    """
+    q = np.linalg.norm(std, axis=1)
+    live = q[(std > 0).all(axis=1)]
+    if not len(live):
+        live = q
+    k = min(_FLOOR_BLOCKS, len(live)) - 1
+    return np.flatnonzero(q <= 2.0 * np.partition(live, k)[k] + 1e-300)
+
+
 def static_level(gyro: np.ndarray, block: int) -> tuple[np.ndarray, np.ndarray, float]:
     """Baseline, per-sample noise and bias drift of the standstill blocks of `block` samples.
 
-    Quiet blocks (spread within 2x of the quietest tenth) are clustered by their mean.
-    A steady turn is as quiet as standstill; of the well-populated levels, standstill is
-    the one nearest zero, since biases are small next to any calibration turn.
+    Quiet blocks (spread at the noise floor) are clustered by their mean. A steady turn may be as
+    quiet as standstill; of the levels seen in at least two blocks, standstill is the one nearest
+    zero, since biases are small next to any calibration turn. However small a share of the log
+    rest is, its blocks are all quiet and nearest zero, so they are always among those compared.
     """
     n = len(gyro) // block
     if n < 1:
         return np.median(gyro, axis=0), gyro.std(axis=0), 0.0
-    step = max(1, n // (_MAX_BLOCK_SAMPLES // block + 1))
-    b = gyro[: n * block].reshape(n, block, 3)[::step]
-    mean = b.sum(axis=1) / block
-    std = np.sqrt(np.maximum(np.einsum("nki,nki->ni", b, b) / block - mean**2, 0.0))
-    q = np.linalg.norm(std, axis=1)
-    quiet = np.flatnonzero(q <= 2.0 * np.percentile(q, 10) + 1e-300)
-    # at most _MAX_CLUSTER blocks, evenly spread (a floor-division stride let up to twice as many through)
-    quiet = quiet[np.linspace(0, len(quiet) - 1, min(len(quiet), _MAX_CLUSTER)).astype(np.intp)]
+    mean, std = _block_stats(np.asarray(gyro, dtype=float), block, n)
+    quiet = _quiet_blocks(std)
     m, s = mean[quiet], std[quiet]
-    radius = 6.0 * float(np.linalg.norm(np.median(s, axis=0))) / np.sqrt(block) + 1e-12 * float(np.abs(m).max())
-    count, members_of = _neighbours(m, radius)
     sq = np.einsum("ij,ij->i", m, m)
-    # Of the dense levels, standstill is the smallest: biases are small next to any turn.
-    dense = np.flatnonzero(count >= min(int(count.max()), max(2, 0.05 * count.max())))
-    members = members_of(int(dense[np.argmin(sq[dense])]))
-    base = np.median(m[members], axis=0)
-    sd = np.median(s[members], axis=0)
+    radius = 6.0 * float(np.linalg.norm(np.median(s, axis=0))) / np.sqrt(block) + 1e-12 * float(np.sqrt(sq.max()))
+    # compared pairwise: the quiet blocks nearest zero (standstill's among them), at most _MAX_CLUSTER
+    near = np.argsort(sq, kind="stable")[:_MAX_CLUSTER]
+    count, _ = _neighbours(m[near], radius)
+    dense = np.flatnonzero(count >= min(int(count.max()), 2))
+    centre = m[near[dense[np.argmin(sq[near[dense]])]]]
+    # its members among all quiet blocks, re-centred once: the block nearest zero is on the cluster's edge
+    for _ in range(2):
+        members = np.flatnonzero(np.einsum("ij,ij->i", m - centre, m - centre) < radius * radius)
+        centre = np.median(m[members], axis=0)
+    base, sd = centre, np.median(s[members], axis=0)
     # Bias drift between pauses: the spread of the standstill levels beyond what noise explains
     # (the 90th percentile of a 3-d normal's radius is about 2.5 sigma).
     p90 = float(np.percentile(np.linalg.norm(m[members] - base, axis=1), 90))

@@ -1,0 +1,97 @@
+"""Whitespace-separated tables: the compiled reader (pyarrow kernels) against the pure-Python one.
+
+Reference: the pure-Python reader (``use_pyarrow=False``), which splits each line with ``str.split``.
+Both round each decimal cell to the nearest double, so the numbers agree to the last bit.
+"""
+
+from __future__ import annotations
+
+import gzip
+
+import numpy as np
+import pytest
+
+from gyrocal.errors import InputError
+from gyrocal.io.csvfile import read_csv_columns
+
+
+def _both(path, columns=None):
+    fast, slow = (read_csv_columns(path, columns, use_pyarrow=u) for u in (True, False))
+    for got, want in zip(fast, slow):
+        assert list(got) == list(want)
+        for name in want:
+            if want[name].dtype == np.float64:
+                np.testing.assert_array_equal(got[name], want[name])
+            else:
+                assert [str(v) for v in got[name]] == [str(v) for v in want[name]]
+    return fast
+
+
+def _rows(rng, n=50):
+    return np.column_stack([np.arange(n) * 0.005, rng.normal(0.0, 30.0, (n, 3))])
+
+
+def test_runs_of_spaces_and_tabs_blank_lines_and_crlf(tmp_path, rng):
+    rows = _rows(rng)
+    lines = [f"  {t!r} \t {x!r}   {y!r}\t{z!r}  " for t, x, y, z in rows.tolist()]
+    lines[10:10] = ["", "   \t "]  # blank lines inside the data are no rows
+    path = tmp_path / "spaced.txt"
+    path.write_bytes(("t gx gy gz\r\n" + "\r\n".join(lines) + "\r\n").encode())
+    data, extra = _both(path)
+    np.testing.assert_array_equal(np.column_stack([data[c] for c in ("t", "gx", "gy", "gz")]), rows)
+    assert extra == {}
+
+
+def test_imu_tk_headerless_gzip_and_comment_header(tmp_path, rng):
+    rows = _rows(rng)
+    body = "".join(f"  {t:.6f}  {x:.9f}  {y:.9f}  {z:.9f}\n" for t, x, y, z in rows)
+    path = tmp_path / "gyro.mat.gz"
+    path.write_bytes(gzip.compress(("# imu_tk gyro log\n" + body).encode()))
+    data, _ = _both(path, "t=1,gx=2,gy=3,gz=4")
+    np.testing.assert_allclose(data["gx"], rows[:, 1], atol=0.5e-9)  # written with 9 decimals
+
+
+def test_text_columns_missing_cells_and_latin1(tmp_path, rng):
+    rows = _rows(rng, 6)
+    axis = ["x", "x", "y", "y", "z", "z"]
+    note = ["caf\xe9", "a", "b", "c", "d", "e"]
+    lines = [f"{t!r} {x!r} {y!r} {'nan' if i == 3 else repr(z)} {a} {n}"
+             for i, ((t, x, y, z), a, n) in enumerate(zip(rows.tolist(), axis, note))]
+    path = tmp_path / "mixed.txt"
+    path.write_bytes(("t gx gy gz axis note\n" + "\n".join(lines) + "\n").encode("latin-1"))
+    (data, extra), (slow, _) = (read_csv_columns(path, use_pyarrow=u) for u in (True, False))
+    np.testing.assert_array_equal(data["gz"], slow["gz"])
+    assert list(data["axis"]) == axis and np.isnan(data["gz"][3])
+    assert list(extra["note"]) == note  # read as latin-1, as the CSV reader does (the Python one writes U+FFFD)
+
+
+def test_decimal_commas_between_spaces(tmp_path, rng):
+    rows = np.round(_rows(rng), 4)
+    text = "t gx gy gz\n" + "".join(" ".join(f"{v:.4f}".replace(".", ",") for v in r) + "\n" for r in rows)
+    (tmp_path / "comma.txt").write_text(text)
+    data, _ = _both(tmp_path / "comma.txt")
+    np.testing.assert_array_equal(data["gy"], rows[:, 2])
+
+
+@pytest.mark.parametrize("bad, message", [
+    ("0.02 1 2", r"data row 3 has 3 fields, the header has 4"),
+    ("0.02 1 2 3 4", r"data row 3 has 5 fields, the header has 4"),
+    ("0.02 1 two 3", r"column 'gy' holds non-numeric cell 'two' at data row 3"),
+])
+def test_bad_rows_are_refused_alike(tmp_path, bad, message):
+    path = tmp_path / "bad.txt"
+    path.write_text("t gx gy gz\n0 1 2 3\n\n0.01 1 2 3\n" + bad + "\n0.03 1 2 3\n")
+    for use_pyarrow in (True, False):
+        with pytest.raises(InputError, match=message):
+            read_csv_columns(path, use_pyarrow=use_pyarrow)
+
+
+def test_header_only_and_utf16(tmp_path, rng):
+    (tmp_path / "empty.txt").write_text("t gx gy gz\n")
+    data, _ = _both(tmp_path / "empty.txt")
+    assert all(len(v) == 0 for v in data.values())
+    rows = _rows(rng, 10)
+    text = "t gx gy gz\n" + "".join(" ".join(map(repr, r)) + "\n" for r in rows.tolist())
+    (tmp_path / "u16.txt").write_bytes(text.encode("utf-16"))
+    data, _ = _both(tmp_path / "u16.txt")
+    np.testing.assert_array_equal(data["gz"], rows[:, 3])
