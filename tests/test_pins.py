@@ -210,3 +210,17 @@ def test_a_fit_is_flagged_below_p_one_in_a_thousand(p, flagged):
     quality = assess_fit(residuals, [f"w{i}" for i in range(20)], 6, what="the turns")
     assert quality.p_value == pytest.approx(p, rel=1e-9)
     assert quality.covariance_scaled is flagged and bool(quality.warnings) is flagged
+
+
+@pytest.mark.parametrize("a, moved", [(0.48, False), (0.6, True)])
+def test_a_step_between_neighbouring_blocks_is_judged_against_sqrt2_sigma(a, moved):
+    """Reference: the difference of two block means of the same noise has sqrt(2) times one mean's sigma.
+    Samples alternate +-1 (each 1 s block: mean 0, spread 1, so a mean's sigma is 1 / sqrt(100) = 0.1 exactly);
+    two neighbouring blocks move by +a and -a: |dev| = a stays under 8 sigma, and their step 2a is judged against
+    8 sqrt(2) x 0.1 = 1.13 (0.96: still, 1.2: a motion)."""
+    from gyrocal.stillness import find_motion
+
+    x = np.tile(np.where(np.arange(100) % 2, -1.0, 1.0), 200)[:, None] * np.ones(3)
+    x[5000:5100] += a
+    x[5100:5200] -= a
+    assert bool(find_motion(x, 100.0).moving.any()) is moved
