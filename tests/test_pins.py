@@ -224,3 +224,15 @@ def test_a_step_between_neighbouring_blocks_is_judged_against_sqrt2_sigma(a, mov
     x[5000:5100] += a
     x[5100:5200] -= a
     assert bool(find_motion(x, 100.0).moving.any()) is moved
+
+
+def test_rate_random_walk_is_read_on_the_plus_half_line():
+    """Reference: IEEE Std 952-1997, Annex C: a rate random walk K gives an Allan variance K^2 tau / 3, so the
+    +1/2 line reads K = sigma(tau) sqrt(3 / tau); on a curve of white noise plus a random walk (no floor),
+    at long tau the white part is 3e-4 of it."""
+    fs, n = 100.0, 10_000_000
+    taus = np.logspace(-2, 4, 61)
+    white, walk = 1e-3, 1e-4
+    adev = np.sqrt(white**2 / taus + walk**2 * taus / 3)
+    rrw = read_figures(taus, np.tile(adev, (3, 1)), fs, n, level=0.683)[3]
+    np.testing.assert_allclose(rrw.value[:3], walk, rtol=2e-3)
