@@ -7,8 +7,8 @@ projects differently in each pose. None of this is in the noise of a window mean
 different for the two kinds of rows: turns (their *reference* is uncertain) and static levels.
 
 A single Birge factor over all rows lets the many static rows dilute the few turn rows: robot
-turns whose angles scatter three times beyond their noise gave chi2/dof 1.5 (p = 0.01: no
-flag) while every scale factor's 1-sigma was a third of its error. Here each group gets its own
+turns whose angles scatter three times beyond their noise give chi2/dof 1.5 (p = 0.01: no
+flag) while every scale factor's 1-sigma is a third of its error. Here each group gets its own
 extra variance, as random-effects averages do (Paule and Mandel, J. Res. NBS 87, 1982):
 
 * turns: one extra variance of the reference, ``tau^2``: of the angle [rad^2] for whole turns

@@ -21,9 +21,9 @@ Layout (SI units, recorded in ``units``; ``null`` for a figure not seen)::
     }
 
 ``density.tau_min``/``tau_max`` (the tau range its -1/2 line was fitted over; ``tau`` is 1 s, where
-it is read, ``edf`` the fit's effective dof) came later too: files without them load, with NaN.
+it is read, ``edf`` the fit's effective dof) are optional: files without them load, with NaN.
 ``analysed.temperature`` (the sensor temperature's range over the analysed stretch, null for a
-log without one) came after version 2 was first written: a version 2 file without it still loads.
+log without one) is optional too: a version 2 file without it loads.
 Version 1 files (gyro only, no intervals) are upgraded by :func:`upgrade_v1`, through
 :mod:`gyrocal.legacy`. The ``--noise-density`` argument of several commands accepts such a
 file (:func:`noise_density_arg`).

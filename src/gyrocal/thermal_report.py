@@ -67,7 +67,7 @@ def write_report(cal: ThermalCalibration, evaluation: Evaluation, out_dir: str |
         if rows:
             _write_rows(out / name, rows)
             written.append(out / name)
-        else:  # an earlier report's table would no longer belong to this one
+        else:  # a table an earlier report left would not belong to this one
             (out / name).unlink(missing_ok=True)
     rms_cols = ["rotating_axis", "gyro_axis"] + [f"{m}_rms" for m in METHODS] + ["lagrange_rms_reduction_pct"]
     mean_cols = ["rotating_axis", "gyro_axis"] + [f"{m}_mean" for m in METHODS]

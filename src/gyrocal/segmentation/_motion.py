@@ -117,7 +117,7 @@ def _neighbours(points: np.ndarray, radius: float, chunk: int = 256):
     """How many of `points` (q, 3) lie within `radius` of each, and a look-up of one's neighbours.
 
     Distances are taken `chunk` rows at a time, so memory stays at ``chunk x q`` whatever q is: a
-    whole ``q x q`` matrix was most of the peak memory of a long recording.
+    whole ``q x q`` matrix would be most of the peak memory of a long recording.
     """
     r2 = radius * radius
 
