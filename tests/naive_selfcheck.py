@@ -23,6 +23,7 @@ import numpy as np
 from gyrocal._validation import finite_array, positive
 from gyrocal.errors import InputError
 from gyrocal.observations import Observation
+from gyrocal.partial_cycles import partial_cycles, weigh_readings
 
 
 def _time_weights(t: np.ndarray, n: int) -> np.ndarray:
@@ -139,17 +140,20 @@ def window_stats(rec, windows, reference, times, *, long_run, ripple):
         t = (t - t[0]) / float(np.median(np.diff(t)))
         level, factor[i], resid[i] = fit_level(blocks[i], t, lines)
         if ripple:
-            out[i] = {"level": level}
+            out[i] = {"level": level, "cycles": partial_cycles(gyro, span[i], blocks[i], t, lines, level)}
     if long_run and plateaus:
         a, b = ref.span_variance([resid[i] for i in plateaus])
         for i in plateaus:
             out.setdefault(i, {})["mean_var"] = b * factor[i] + a * factor[i] ** 2
+    lrv = None
     if long_run and statics:
         lrv = _pooled_lrv([blocks[i] - blocks[i].mean(axis=0) for i in statics])
         for i in statics:
             out[i] = {"mean_var": lrv / len(blocks[i])}
         for i in turns:
             out[i] = {"mean_var": lrv * d / len(windows[i])}
+    if ripple and plateaus:  # the two readings of the declared speed, as the library weighs them
+        weigh_readings(out, {i: windows[i] for i in plateaus}, {i: blocks[i] for i in statics}, lrv)
     return out
 
 

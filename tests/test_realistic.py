@@ -236,3 +236,24 @@ def test_the_generators_plateau_ripple_has_zero_mean_over_the_true_plateau():
     cruise = log.gyro[int(round((t0 + 0.3) * 1000)) + 2: int(round((t0 + 6.0) * 1000)) - 2, 0]
     assert abs(cruise.mean() - 60.0) < 0.01 and 2.9 < (cruise.max() - cruise.min()) / 2 < 3.1
     assert abs(log.gyro[:, 0].sum() / 1000 - 360.0) < 0.05  # the turn still turns its angle
+
+
+@pytest.mark.parametrize("model", ["plateau_ripple", "ripple"])
+def test_speed_ripple_on_the_plateau_only_or_about_the_speed(tmp_path, model):
+    """Issue 22 item 8: k = (1.8, 0.6, 1.25), 8 deg mount, 0.5 deg/s white noise at 200 Hz, 0.3 s ramps, 5 % ripple
+    at 2.5 Hz either on the cruise only with zero mean over it (the declared speed is the plateau's mean) or about
+    the commanded speed (its level under the ripple). The two readings differ by the ripple's partial cycles over
+    the whole plateau; opposite turns against the standstill offset tell which holds. Before, for the plateau-only
+    ripple: RMS z 1.59, max 4.36 over 20 seeds. Band: the issue's target above, four spreads of 24 z below."""
+    gyro = R.Gyro(k=(1.8, 0.6, 1.25), mount_deg=8.0, noise_density=0.5 / 40, dlpf_hz=None, flicker=0.0)
+    z, ratio = [], []
+    for seed in range(8):
+        plan = _six(profile="trapezoid", accel=200.0, **{model: 0.05})
+        rec_log = R.record(plan, gyro, rate=200.0, stamps="sensor", seed=seed, earth=False)
+        rec = _read(rec_log, tmp_path)
+        run = calibrate(rec, speed=math.radians(60))
+        plain = calibrate(rec, speed=math.radians(60), checks=False, long_run=False)
+        z.append(_z(run, rec_log, earth=False))
+        ratio.append(run.fit.std[:3] / plain.fit.std[:3])
+    assert 1 - 4 / math.sqrt(2 * np.size(z)) <= _rms(z) <= 1.5
+    assert np.abs(z).max() < 4 and np.mean(ratio) <= 3.0

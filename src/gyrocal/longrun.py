@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["block_means", "find_lines", "fit_level", "fit_levels", "newey_west_var", "span_variance"]
+__all__ = ["block_means", "find_lines", "fit_level", "fit_levels", "line_mean", "newey_west_var", "ramp_end",
+           "span_variance"]
 
 
 def newey_west_var(x: np.ndarray, lags: int | None = None, *, prewhiten: bool = True) -> np.ndarray:
@@ -199,6 +200,36 @@ def fit_levels(xs: list[np.ndarray], ts: list[np.ndarray], lines: list[float]) -
             inverses[len(t)] = np.linalg.inv(X.T @ X)
         out.append(_solve(x, X, inverses[len(t)]))
     return out
+
+
+def line_mean(x: np.ndarray, t: np.ndarray, lines: list[float], lo: float, hi: float) -> np.ndarray:
+    """Mean over ``[lo, hi]`` (times as `t`, in steps) of the sinusoids at `lines` fitted to `x` (n, k) with a constant."""
+    if not lines or hi <= lo:
+        return np.zeros(x.shape[1])
+    coef = np.linalg.lstsq(_design(t, lines), x, rcond=None)[0]
+    w = 2 * np.pi * np.asarray(lines)
+    ds, dc = (np.sin(w * hi) - np.sin(w * lo)) / w, (np.cos(w * hi) - np.cos(w * lo)) / w
+    return (ds @ coef[1::2] - dc @ coef[2::2]) / (hi - lo)
+
+
+def ramp_end(y: np.ndarray, level: float) -> float | None:
+    """Where the ramp in `y` (n,), rising towards its end, reaches `level` > 0: the line through its
+    middle (a fifth to four fifths of the level) meeting the level, in steps from ``y[0]``; None when
+    `y` holds no such ramp (a slope of at least a tenth of the level over its middle's span is needed)."""
+    below = np.flatnonzero(y < 0.5 * level)
+    if not len(below):
+        return None
+    q = int(below[-1])
+    low = np.flatnonzero(y[:q + 1] < 0.2 * level)
+    high = np.flatnonzero(y[q:] >= 0.8 * level)
+    lo, hi = (int(low[-1]) + 1 if len(low) else 0), (q + int(high[0]) if len(high) else len(y))
+    i = np.arange(lo, hi)
+    if len(i) < 2:
+        return None
+    slope, icpt = np.polyfit(i, y[lo:hi], 1)
+    if slope * (hi - lo) < 0.1 * level:
+        return None
+    return float(np.clip((level - icpt) / slope, q, len(y)))
 
 
 def block_means(x: np.ndarray, d: int) -> np.ndarray:

@@ -30,6 +30,7 @@ import numpy as np
 
 from .longrun import block_means, find_lines, fit_levels, newey_west_var, span_variance
 from .observations import Observation, observe_many
+from .partial_cycles import partial_cycles, weigh_readings
 from .recording import Recording
 from .windows import Window
 
@@ -103,7 +104,7 @@ def _window_stats(rec: Recording, windows: Sequence[Window], reference: str, tim
     statics = [i for i in blocks if windows[i].kind == "static"]
     out: dict[int, dict] = {}
     if plateaus:
-        out = _plateau_stats(blocks, span, plateaus, times, d, long_run=long_run, ripple=ripple)
+        out = _plateau_stats(gyro, blocks, span, plateaus, times, d, long_run=long_run, ripple=ripple)
     lrv = None
     if long_run and statics:
         lrv = _pooled_lrv([lambda b=blocks[i]: b - b.mean(axis=0) for i in statics], [len(blocks[i]) for i in statics])
@@ -114,6 +115,9 @@ def _window_stats(rec: Recording, windows: Sequence[Window], reference: str, tim
     if lrv is not None:
         for i in turns:  # the turn's mean integrates the same sensor noise over its length
             out[i] = {"mean_var": lrv * d / len(windows[i])}
+    if plateaus and ripple:
+        weigh_readings(out, {i: windows[i] for i in plateaus}, {i: blocks[i] for i in statics},
+                       None if lrv is None or not statics else lrv)
     return out
 
 
@@ -146,9 +150,9 @@ def _turns_lrv(turns: list[np.ndarray]) -> np.ndarray | None:
     return np.where(np.isnan(lrv), np.nanmean(lrv), lrv)
 
 
-def _plateau_stats(blocks: dict, span: dict, plateaus: list[int], times: np.ndarray | None, d: int, *,
-                   long_run: bool, ripple: bool) -> dict[int, dict]:
-    """Levels (ripple regressed out) and mean variances of the plateaus, block means of `d` samples."""
+def _plateau_stats(gyro: np.ndarray, blocks: dict, span: dict, plateaus: list[int], times: np.ndarray | None, d: int,
+                   *, long_run: bool, ripple: bool) -> dict[int, dict]:
+    """Levels (ripple regressed out) and mean variances of the plateaus, block means of `d` samples (`gyro`)."""
     lines: list[float] = []
     if ripple:
         b = blocks[max(plateaus, key=lambda i: len(blocks[i]))]
@@ -165,8 +169,12 @@ def _plateau_stats(blocks: dict, span: dict, plateaus: list[int], times: np.ndar
             ts.append((t - t[0]) / float(np.median(np.diff(t))))
     fits = dict(zip(plateaus, fit_levels([blocks[i] for i in plateaus], ts, lines)))
     out: dict[int, dict] = {i: {"level": fits[i][0]} for i in plateaus} if ripple else {}
+    if ripple:  # the two readings of a declared speed; weighed once the static windows are known
+        for i, t in zip(plateaus, ts):
+            out[i]["cycles"] = partial_cycles(gyro, span[i], blocks[i], t, lines, fits[i][0])
     if long_run:
         a, b = span_variance([fits[i][2] for i in plateaus])
         for i in plateaus:
             out.setdefault(i, {})["mean_var"] = b * fits[i][1] + a * fits[i][1] ** 2
     return out
+
