@@ -236,3 +236,20 @@ def test_rate_random_walk_is_read_on_the_plus_half_line():
     adev = np.sqrt(white**2 / taus + walk**2 * taus / 3)
     rrw = read_figures(taus, np.tile(adev, (3, 1)), fs, n, level=0.683)[3]
     np.testing.assert_allclose(rrw.value[:3], walk, rtol=2e-3)
+
+
+def test_a_temperature_point_has_the_ols_standard_errors_with_n_minus_4_dof():
+    """Reference: ordinary least squares per output axis, rate = K w + B (4 parameters), standard errors
+    sqrt(diag((X'X)^-1) RSS / (n - 4)) computed here with numpy's lstsq (the full-temperature-range method, eq. 19)."""
+    from gyrocal.thermal.fit import fit_point
+
+    rng = np.random.default_rng(19)
+    n = 9
+    ref = rng.uniform(-1.0, 1.0, (n, 3))
+    means = ref @ np.array([[1.01, 0.002, 0.0], [0.0, 0.99, 0.003], [0.001, 0.0, 1.0]]).T + 0.01
+    means = means + rng.normal(0.0, 1e-3, means.shape)
+    point = fit_point(ref, means, np.full((n, 3), 1e-6), np.full(n, 100.0))
+    X = np.column_stack([ref, np.ones(n)])
+    _, rss, _, _ = np.linalg.lstsq(X, means, rcond=None)
+    se = np.sqrt(np.outer(np.diag(np.linalg.inv(X.T @ X)), rss / (n - 4)))  # (4 parameters, 3 axes)
+    np.testing.assert_allclose(np.sort(point.std.ravel()), np.sort(se.ravel()), rtol=1e-9)
