@@ -80,7 +80,7 @@ def thermal_bias(
     units: READING.Units = None,
     columns: READING.Columns = None,
     sample_rate: READING.SampleRate = None,
-    sensitivity: READING.Sensitivity = None,
+    sensitivity: READING.SensitivityKept = None,
     output_units: READING.OutputUnits = None,
     imu: READING.Imu = None,
     max_order: Annotated[int, typer.Option("--max-order", help="Highest order tried, 0-3 (firmwares take cubics).")]
