@@ -57,6 +57,9 @@ class ReadingFlags:
         self.SensitivityNeeded = sensitivity("required with --units counts")
         #: a fit that works in counts as well
         self.SensitivityKept = sensitivity("default: none; the rates stay in counts")
+        #: a test log read in its calibration's output unit
+        self.SensitivityOfCalibration = sensitivity("required with --units counts",
+                                                    " (per rad/s for a calibration in rad/s)")
         #: a log read without --output-units (a reference)
         self.SensitivityDegS = sensitivity("default: none; the rates stay in counts", "")
         self.OutputUnits = Annotated[Optional[str], opt(

@@ -36,8 +36,8 @@ WindowsFile = Annotated[Optional[Path], typer.Option(
     "--windows", help="Windows file (JSON/CSV list, or imucal's section list) that replaces detection "
     "(default: detected).")]
 Speed = Annotated[Optional[str], typer.Option(
-    "--speed", help="Known constant turn rate: a number in the data's rate unit (deg/s with --units deg/s; "
-    "--output-units for counts), or with its unit, e.g. 60deg/s or 1.05rad/s (default: none, --angle 360).")]
+    "--speed", help="Known constant turn rate, in the data's rate unit unless a unit is written (deg/s with --units "
+    "deg/s; --output-units for counts), e.g. 60deg/s or 1.05rad/s (default: none, --angle 360).")]
 Angle = Annotated[Optional[float], typer.Option(
     "--angle", help="Known angle of each turn, in degrees; the speed may vary (default: 360 unless --speed).")]
 AngleSd = Annotated[Optional[float], typer.Option(

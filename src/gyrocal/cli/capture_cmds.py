@@ -159,8 +159,8 @@ def capture(
     = 2.0,
     accel_units: Annotated[AccelUnit, typer.Option("--accel-units", help="Unit of text lines' ax, ay, az (frames "
                                                    "send counts).")] = "counts",
-    accel_sensitivity: Annotated[float | None, typer.Option("--accel-sensitivity", help="Accelerometer counts per g "
-                                                            "(frames: the device says) (default: none).")] = None,
+    accel_sensitivity: Annotated[float | None, typer.Option("--accel-sensitivity", help="For --accel-units counts: "
+                                                            "LSB per g (frames: the device says) (default: none).")] = None,
     calibration: Annotated[Path | None, typer.Option("--cal", help="Calibration file to write when the "
                                                         "guide completes (default: beside -o, .cal.json).")] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace existing output files.")] = False,

@@ -168,7 +168,7 @@ def thermal_report(
     columns: READING.Columns = None,
     skip_rows: READING.SkipRows = None,
     sample_rate: READING.SampleRate = None,
-    sensitivity: READING.SensitivityNeeded = None,
+    sensitivity: READING.SensitivityOfCalibration = None,
     settle: Settle = 2.0,
     full_scale: FullScale = None,
     temp_tolerance: TempTol = 2.0,
