@@ -19,20 +19,10 @@ def _rate_arg(name: str, text: str | None, default_unit: str) -> float | None:
     """A rate with an optional unit suffix (``0.01deg/s``, ``2e-4 rad/s``) in rad/s."""
     from ..units import unit_factor
 
-    if text is None:
-        return None
-    raw = text.strip().lower().replace(" ", "")
-    unit = default_unit
-    for suffix in ("deg/s", "dps", "rad/s"):
-        if raw.endswith(suffix):
-            raw, unit = raw[: -len(suffix)], suffix
-    try:
-        value = float(raw) * unit_factor(unit)
-    except ValueError:
-        raise InputError(f"{name} must be a number with an optional unit (deg/s or rad/s), got {text!r}") from None
-    if not (math.isfinite(value) and value > 0):
+    value = in_unit(name, text, default_unit)
+    if value is not None and not (math.isfinite(value) and value > 0):
         raise InputError(f"{name} must be > 0, got {text!r}")
-    return value
+    return None if value is None else value * unit_factor(default_unit)
 
 
 #: Flags of one kind of design only (the rest apply to both).
@@ -99,6 +89,7 @@ def plan(
     speed, max_speed, peak_rate = (in_unit(f"--{n}", v, "deg/s") for n, v in (
         ("speed", speed), ("max-speed", max_speed), ("peak-rate", peak_rate)))
     noise = in_unit("--noise", noise, "rad/s")
+    positive("speed", speed)
     positive("max_speed", max_speed)
     for name in ("target_scale", "target_cross", "target_accel_scale", "target_accel_offset"):
         if ctx.params[name] is not None:
