@@ -150,13 +150,14 @@ def test_profile_from_callable_and_from_table(rng):
 
 
 def test_help_keeps_the_units_written_in_brackets():
-    """Help texts give units as [deg/s]; rich markup would swallow them as tags."""
+    """Help texts give units as [degC]; rich markup would swallow them as tags (rates say 'deg/s unless a unit
+    is written' instead)."""
     code, out, _ = invoke("simulate", "--help")
     assert code == 0
-    for text in ("[deg/s]", "[degC]"):
+    for text in ("[rad/s/degC^n]", "[degC]", "[m/s^2/sqrt(Hz)]"):
         assert text in out
     code, out, _ = invoke("calibrate", "--help")
-    assert code == 0 and "[rad/s/sqrt(Hz)]" in out
+    assert code == 0 and "[Hz]" in out
 
 
 def test_outputs_replace_only_their_own_kind(tmp_path):

@@ -10,7 +10,8 @@ import typer
 
 from ..errors import InputError
 
-__all__ = ["AcceptImplausible", "NoiseDensity", "StoreUrl", "given", "judge_plausible", "iso_time", "noise_std", "numbers", "refuse_unused", "triple"]
+__all__ = ["AcceptImplausible", "NoiseDensity", "StoreUrl", "given", "in_unit", "iso_time", "judge_plausible",
+           "list_in_unit", "noise_density_option", "noise_std", "numbers", "refuse_unused", "triple", "triple_in_unit"]
 
 
 def given(ctx: typer.Context, name: str) -> bool:
@@ -52,10 +53,15 @@ def triple(name: str, text: str | None, default) -> list[float]:
     return values
 
 
-NoiseDensity = Annotated[Optional[str], typer.Option(
-    "--noise-density",
-    help="White-noise density: rad/s/sqrt(Hz), 'N deg/s/rtHz', or a noise JSON from 'gyrocal noise --json' "
-         "(default: none; --noise, or the study's own levels, apply).")]
+def noise_density_option(otherwise: str):
+    """The --noise-density option; `otherwise` says what applies without it (this command's own words)."""
+    return Annotated[Optional[str], typer.Option(
+        "--noise-density", help="White-noise density: rad/s/sqrt(Hz) unless a unit is written ('N deg/s/rtHz'), or "
+        f"a noise file from 'gyrocal noise -o' (default: none; {otherwise}).")]
+
+
+#: --noise-density where --noise is the other way to give the noise (simulate, plan).
+NoiseDensity = noise_density_option("--noise applies")
 
 
 def noise_std(noise: float | None, density: str | None, sample_rate: float, default: float, *,
@@ -102,6 +108,12 @@ def in_unit(flag: str, text: str | None, unit: str) -> float | None:
         raise InputError(f"{flag} must be a number, with a unit if you like (0.035rad/s, 2deg/s), got {text!r}") \
             from None
     return value * _RATE_UNITS[given_unit or unit] / _RATE_UNITS[unit]
+
+
+def list_in_unit(flag: str, text: str, unit: str) -> list[float]:
+    """Comma-separated rates in `unit`; one unit written after the last applies to all."""
+    raw, given_unit = _split_unit(flag, text)
+    return [v * _RATE_UNITS[given_unit or unit] / _RATE_UNITS[unit] for v in numbers(flag, raw)]
 
 
 def triple_in_unit(flag: str, text: str | None, unit: str, default) -> list[float]:

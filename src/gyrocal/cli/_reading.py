@@ -28,7 +28,12 @@ class ReadingFlags:
 
     def __init__(self, prefix: str = ""):
         def opt(name: str, help: str, **kw):
-            return typer.Option(f"--{prefix}{name}", help=help, **kw)
+            # the reading flags a help text names carry the same prefix
+            return typer.Option(f"--{prefix}{name}", help=re.sub(r"--(?=[a-z])", f"--{prefix}", help), **kw)
+
+        def sensitivity(without: str, per_rad: str = " (per rad/s with --output-units rad/s)"):
+            return Annotated[Optional[float], opt(
+                "sensitivity", f"For --units counts: LSB per deg/s{per_rad} ({without}).")]
 
         units = "<rad/s|deg/s|counts>"
         self.Units = Annotated[Optional[str], opt(
@@ -46,11 +51,19 @@ class ReadingFlags:
         self.SampleRate = Annotated[Optional[float], opt(
             "sample-rate", "Nominal sample rate [Hz]; needed when the file has no time column (default: from the "
             "time column, which wins when both are there).")]
-        self.Sensitivity = Annotated[Optional[float], opt(
-            "sensitivity", "For --units counts: LSB per --output-units rate unit (default: none; the scale "
-            "factors absorb it).")]
+        #: a calibration: without it the scale factors absorb the sensitivity
+        self.Sensitivity = sensitivity("default: none; the scale factors absorb it")
+        #: commands whose results are physical quantities
+        self.SensitivityNeeded = sensitivity("required with --units counts")
+        #: a fit that works in counts as well
+        self.SensitivityKept = sensitivity("default: none; the rates stay in counts")
+        #: a test log read in its calibration's output unit
+        self.SensitivityOfCalibration = sensitivity("required with --units counts",
+                                                    " (per rad/s for a calibration in rad/s)")
+        #: a log read without --output-units (a reference)
+        self.SensitivityDegS = sensitivity("default: none; the rates stay in counts", "")
         self.OutputUnits = Annotated[Optional[str], opt(
-            "output-units", "Unit of corrected rates, rad/s or deg/s (default: the data's; deg/s for counts).",
+            "output-units", "Rate unit of the results, rad/s or deg/s (default: the data's; deg/s for counts).",
             metavar="<rad/s|deg/s>")]
         self.Topic = Annotated[Optional[str], opt(
             "topic", "sensor_msgs/Imu topic in a ROS 1/ROS 2/MCAP bag (default: the only one).")]

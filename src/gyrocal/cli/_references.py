@@ -45,12 +45,21 @@ def reference_of(speed: float | None, angle: float | None, rate_unit: str, *, sp
         None if angle_sd is None else math.radians(angle_sd)
 
 
-def noise_to_internal(noise_std: float | None, units: str, rate_unit: str, sensitivity: float | None) -> float | None:
-    """--noise-std [the data's unit] in the recording's internal unit."""
+def noise_to_internal(text: str | None, units: str, rate_unit: str, sensitivity: float | None) -> float | None:
+    """--noise-std (the data's unit unless a unit is written) in the recording's internal unit."""
     from ..units import unit_factor
+    from ._options import in_unit
 
-    if noise_std is None:
+    if text is None:
         return None
+    try:
+        noise_std = float(text)
+    except ValueError:  # written with its unit
+        noise_std = in_unit("--noise-std", text, "rad/s")
+        if units == "counts" and sensitivity is None:
+            raise InputError(f"--noise-std {text} is a rate; with --units counts give --sensitivity, or the noise "
+                             "in counts") from None
+        units, sensitivity = "rad/s", None
     if not (math.isfinite(noise_std) and noise_std > 0):
         raise InputError(f"--noise-std must be a positive number, got {noise_std:g}")
     if units != "counts":

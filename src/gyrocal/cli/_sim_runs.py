@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 
 from ..errors import InputError
-from ._options import numbers
+from ._options import list_in_unit, numbers
 
 __all__ = ["multi_position", "profile_run", "turntable", "turntable_protocol"]
 
@@ -20,7 +20,7 @@ def turntable_protocol(temps: str | None, rates: str | None, step_duration: floa
     if temps is not None:
         kw["temps"] = tuple(numbers("--temps", temps))
     if rates is not None:
-        kw["rates"] = tuple(numbers("--rates", rates))
+        kw["rates"] = tuple(list_in_unit("--rates", rates, "deg/s"))
     if step_duration is not None:
         kw["step_duration"] = step_duration
     return TurntableProtocol(**kw, temp_noise=temp_noise, temp_quantum=temp_quantum)

@@ -172,7 +172,8 @@ def batch(
     limits: STATION.Limits = None,
     jobs: Annotated[int, typer.Option("-j", "--jobs", help="Worker processes.", min=1)] = 1,
     output_dir: Annotated[Optional[Path], typer.Option(
-        "--output-dir", help="Folder of the result files (default: 'results' beside the manifest).")] = None,
+        "-o", "--output", "--output-dir", help="Folder of the result files (default: 'results' beside the "
+        "manifest); --output-dir is its old name.")] = None,
 ) -> None:
     """Run a manifest of units through their calibration jobs into a store; exit 0 all passed, 1 any failed."""
     from ..station.limits import read_limits

@@ -18,7 +18,7 @@ import typer
 
 from ..choices import Method
 from ..errors import GyrocalError, InputError
-from ._options import AcceptImplausible, in_unit, judge_plausible
+from ._options import AcceptImplausible, in_unit, judge_plausible, noise_density_option
 from ._outputs import check_output, same_document
 from ._reading import READING, read_from_flags, required_units
 from ._references import density_to_internal, noise_to_internal, rate_unit_of, reference_of
@@ -36,16 +36,16 @@ WindowsFile = Annotated[Optional[Path], typer.Option(
     "--windows", help="Windows file (JSON/CSV list, or imucal's section list) that replaces detection "
     "(default: detected).")]
 Speed = Annotated[Optional[str], typer.Option(
-    "--speed", help="Known constant turn rate: a number in the data's rate unit (deg/s with --units deg/s; "
-    "--output-units for counts), or with its unit, e.g. 60deg/s or 1.05rad/s (default: none, --angle 360).")]
+    "--speed", help="Known constant turn rate, in the data's rate unit unless a unit is written (deg/s with --units "
+    "deg/s; --output-units for counts), e.g. 60deg/s or 1.05rad/s (default: none, --angle 360).")]
 Angle = Annotated[Optional[float], typer.Option(
     "--angle", help="Known angle of each turn, in degrees; the speed may vary (default: 360 unless --speed).")]
 AngleSd = Annotated[Optional[float], typer.Option(
     "--angle-sd", help="Accuracy (1-sigma) of each turn's angle, in degrees: a robot's or turntable's "
     "specification, carried into the 1-sigma (default: none, only what the data show).")]
-SpeedSd = Annotated[Optional[float], typer.Option(
-    "--speed-sd", help="Accuracy (1-sigma) of the known speed, in --speed's unit: one error common to every "
-    "plateau, so the three k move together (default: none).")]
+SpeedSd = Annotated[Optional[str], typer.Option(
+    "--speed-sd", help="Accuracy (1-sigma) of the known speed, in the data's rate unit unless a unit is written, as "
+    "--speed: one error common to every plateau, so the three k move together (default: none).")]
 PlotPath = Annotated[Optional[Path], typer.Option(
     "--plot", help="Write a picture (.png, .pdf or .svg) (default: none).")]
 Output = Annotated[Optional[Path], typer.Option(
@@ -197,12 +197,10 @@ def calibrate(
     speed_sd: SpeedSd = None,
     windows: WindowsFile = None,
     method: Annotated[Method, typer.Option("--method", help="Estimator.")] = "first-moment",
-    noise_std: Annotated[Optional[float], typer.Option(
-        "--noise-std", help="Per-sample noise, in the data's unit, instead of the one measured (default: "
-        "measured).")] = None,
-    noise_density: Annotated[Optional[str], typer.Option(
-        "--noise-density", help="Noise density instead of the one measured: a number [rad/s/sqrt(Hz)], "
-        "'N deg/s/rtHz', or a noise JSON from 'gyrocal noise --json' (default: measured).")] = None,
+    noise_std: Annotated[Optional[str], typer.Option(
+        "--noise-std", help="Per-sample noise instead of the one measured, in the data's unit unless a unit is "
+        "written, e.g. 0.05deg/s (default: measured).")] = None,
+    noise_density: noise_density_option("the one measured in the still parts") = None,
     output: Output = None,
     plot: PlotPath = None,
     force: Force = False,
@@ -230,7 +228,7 @@ def calibrate(
         raise InputError("give a recording to calibrate (or --example for the bundled one)")
     units, read_notes = required_units(units), []
     rate_unit = rate_unit_of(units, output_units)
-    speed = _speed(speed, rate_unit)
+    speed, speed_sd = _speed(speed, rate_unit), _speed(speed_sd, rate_unit)
     reference, speed_rad, angle_rad, ref_sd = reference_of(speed, angle, rate_unit, speed_sd=speed_sd,
                                                            angle_sd=angle_sd)
     if ref_sd is not None and method != "first-moment":

@@ -17,6 +17,7 @@ from ..errors import GyrocalError, InputError
 from ._capture_progress import Progress as _Progress
 from ._capture_progress import Stop as _Stop
 from ._capture_progress import say as _say
+from ._options import in_unit
 from ._outputs import check_output
 from ._station import StationFlags, station_flags
 from .app import app, console, warn
@@ -136,8 +137,9 @@ def capture(
                                                    "numbers from 1, e.g. t=1,gx=2,gy=3,gz=4 (default: the header's names).")] = None,
     units: Annotated[InputUnit, typer.Option("--units", help="Unit of the rates received: counts, deg/s or rad/s "
                                        "(frames always send counts).")] = "counts",
-    sensitivity: Annotated[float | None, typer.Option("--sensitivity", help="Counts per deg/s (frames: the "
-                                                         "device says) (default: none; counts are kept).")] = None,
+    sensitivity: Annotated[float | None, typer.Option("--sensitivity", help="For --units counts: LSB per deg/s "
+                                                      "(frames: the device says) (default: none; counts are kept).")]
+    = None,
     sample_rate: Annotated[float | None, typer.Option("--sample-rate", help="[Hz], for text lines without "
                                                          "a time column (default: from the time column).")] = None,
     duration: Annotated[float | None, typer.Option("--duration", help="Stop after S seconds of data (default: no limit).")] = None,
@@ -148,16 +150,17 @@ def capture(
                                                  "servo method of Wang et al.), hand, or multi-position (the whole "
                                                  "IMU from still poses; needs the accelerometer) (default: none, "
                                                  "plain recording).")] = None,
-    speed: Annotated[float | None, typer.Option("--speed", help="Known turn speed [deg/s] (servo); default "
-                                                   "whole 360 deg turns at any speed.")] = None,
+    speed: Annotated[str | None, typer.Option("--speed", help="servo: known turn speed, deg/s unless a unit is "
+                                                 "written, e.g. 1.05rad/s (default: none, whole 360 deg turns at "
+                                                 "any speed).")] = None,
     poses: Annotated[int, typer.Option("--poses", help="multi-position: poses needed (more if they do not yet "
                                                        "cover the sphere).")] = 12,
     hold: Annotated[float, typer.Option("--hold", help="multi-position: still time asked for in each pose [s].")]
     = 2.0,
     accel_units: Annotated[AccelUnit, typer.Option("--accel-units", help="Unit of text lines' ax, ay, az (frames "
                                                    "send counts).")] = "counts",
-    accel_sensitivity: Annotated[float | None, typer.Option("--accel-sensitivity", help="Accelerometer counts per g "
-                                                            "(frames: the device says) (default: none).")] = None,
+    accel_sensitivity: Annotated[float | None, typer.Option("--accel-sensitivity", help="For --accel-units counts: "
+                                                            "LSB per g (frames: the device says) (default: none).")] = None,
     calibration: Annotated[Path | None, typer.Option("--cal", help="Calibration file to write when the "
                                                         "guide completes (default: beside -o, .cal.json).")] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace existing output files.")] = False,
@@ -183,6 +186,9 @@ def capture(
     if write_back and (guide not in ("servo", "hand") or not write_back_timeout > 0):
         raise InputError("--write-back sends the gyro correction of a guided servo or hand session: give --guide "
                          "servo (and a --write-back-timeout > 0)")
+    speed = in_unit("--speed", speed, "deg/s")
+    if speed is not None and not (math.isfinite(speed) and speed > 0):
+        raise InputError(f"--speed must be > 0 deg/s, got {speed:g}")
     session = dict(port=port, baud=baud, wire=wire, columns=columns, duration=duration, samples=samples,
                    silence=silence, guide=guide, speed=speed, poses=poses, hold=hold, force=force, quiet=quiet,
                    reading=_ReadAs(units, sensitivity, sample_rate, accel_units, accel_sensitivity),

@@ -80,7 +80,7 @@ def thermal_bias(
     units: READING.Units = None,
     columns: READING.Columns = None,
     sample_rate: READING.SampleRate = None,
-    sensitivity: READING.Sensitivity = None,
+    sensitivity: READING.SensitivityKept = None,
     output_units: READING.OutputUnits = None,
     imu: READING.Imu = None,
     max_order: Annotated[int, typer.Option("--max-order", help="Highest order tried, 0-3 (firmwares take cubics).")]
@@ -98,8 +98,8 @@ def thermal_bias(
     accept_implausible: AcceptImplausible = False,
     flags: StationFlags = StationFlags(),
 ) -> None:
-    """Fit gyro bias (and accelerometer offset change) against temperature for PX4 and ArduPilot (export with
-    --format px4 or ardupilot)."""
+    """Fit gyro bias (and accelerometer offset change) against temperature for PX4 and ArduPilot (then
+    'gyrocal export --format px4' or ardupilot)."""
     from ..files import to_document
     from ..flight import ThermalBias, fit_thermal_bias
 

@@ -83,7 +83,7 @@ def noise(
     columns: READING.Columns = None,
     skip_rows: READING.SkipRows = None,
     sample_rate: READING.SampleRate = None,
-    sensitivity: READING.Sensitivity = None,
+    sensitivity: READING.SensitivityNeeded = None,
     output_units: READING.OutputUnits = None,
     topic: READING.Topic = None,
     no_unit_check: READING.NoUnitCheck = False,
@@ -98,7 +98,7 @@ def noise(
     json_out: Annotated[Optional[Path], typer.Option(
         "-o", "--output", "--json", help="Write the noise file, gyrocal.noise (default: none); --json is its old "
         "name.")] = None,
-    force: Annotated[bool, typer.Option("--force", help="Replace a --json file that is not a noise file.")]
+    force: Annotated[bool, typer.Option("--force", help="Replace an -o file that is not a noise file.")]
     = False,
     flags: StationFlags = StationFlags(),
 ) -> None:
@@ -117,7 +117,7 @@ def noise(
     unit = required_units(units)
     if unit == "counts" and sensitivity is None:
         raise InputError("noise figures are physical quantities, so raw counts need their sensitivity",
-                         param="sensitivity", hint="give {param} (LSB per --output-units, e.g. 131 for a +-250 deg/s "
+                         param="sensitivity", hint="give {param} (LSB per deg/s, e.g. 131 for a +-250 deg/s "
                                                     "MPU-9250)")
     rec = read_from_flags(recording, units=unit, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
                           sensitivity=sensitivity,

@@ -9,7 +9,7 @@ import typer
 
 from ..choices import PlanDesign
 from ..errors import InputError
-from ._options import NoiseDensity, noise_std, refuse_unused, triple
+from ._options import NoiseDensity, in_unit, noise_std, refuse_unused, triple
 from .app import app, console
 
 __all__ = ["plan"]
@@ -19,20 +19,10 @@ def _rate_arg(name: str, text: str | None, default_unit: str) -> float | None:
     """A rate with an optional unit suffix (``0.01deg/s``, ``2e-4 rad/s``) in rad/s."""
     from ..units import unit_factor
 
-    if text is None:
-        return None
-    raw = text.strip().lower().replace(" ", "")
-    unit = default_unit
-    for suffix in ("deg/s", "dps", "rad/s"):
-        if raw.endswith(suffix):
-            raw, unit = raw[: -len(suffix)], suffix
-    try:
-        value = float(raw) * unit_factor(unit)
-    except ValueError:
-        raise InputError(f"{name} must be a number with an optional unit (deg/s or rad/s), got {text!r}") from None
-    if not (math.isfinite(value) and value > 0):
+    value = in_unit(name, text, default_unit)
+    if value is not None and not (math.isfinite(value) and value > 0):
         raise InputError(f"{name} must be > 0, got {text!r}")
-    return value
+    return None if value is None else value * unit_factor(default_unit)
 
 
 #: Flags of one kind of design only (the rest apply to both).
@@ -46,14 +36,16 @@ _DESIGN_FLAGS = {
 @app.command()
 def plan(
     ctx: typer.Context,
-    speed: Annotated[float, typer.Option("--speed", help="Turn speed [deg/s].")] = 60.0,
+    speed: Annotated[str, typer.Option("--speed", help="Turn speed, deg/s unless a unit is written, e.g. 1.05rad/s.")]
+    = "60",
     revolutions: Annotated[float, typer.Option("--revolutions", help="Revolutions per turn.")] = 1.0,
     design: Annotated[PlanDesign, typer.Option(
         "--design", help="six (the servo method of Wang et al., Fig. 1), six-static, twelve; poses: a hand session "
         "of still poses for 'gyrocal imu'.")] = "six",
     sample_rate: Annotated[float, typer.Option("--sample-rate", help="Sampling rate [Hz].")] = 200.0,
-    noise: Annotated[Optional[float], typer.Option(
-        "--noise", help="Per-sample white noise [rad/s] (default: 0.035, the paper's simulations).")] = None,
+    noise: Annotated[Optional[str], typer.Option(
+        "--noise", help="Per-sample white noise, rad/s unless a unit is written, e.g. 2deg/s (default: 0.035 rad/s, "
+        "the paper's simulations; 0.0017 rad/s for --design poses).")] = None,
     noise_density: NoiseDensity = None,
     k: Annotated[Optional[str], typer.Option(
         "--k", help="Expected scale factors kx,ky,kz (default: 1,1,1).")] = None,
@@ -63,15 +55,16 @@ def plan(
         "--target-scale", help="Target std of every k [-] (default: none; no suggestion).")]
     = None,
     target_bias: Annotated[Optional[str], typer.Option(
-        "--target-bias", help="Target std of every bias, e.g. 0.01deg/s (unit rad/s if none given) (default: "
-        "none; no suggestion).")] = None,
-    max_speed: Annotated[float, typer.Option("--max-speed", help="Fastest speed to consider [deg/s].")] = 180.0,
+        "--target-bias", help="Target std of every bias, rad/s unless a unit is written, e.g. 0.01deg/s "
+        "(default: none; no suggestion).")] = None,
+    max_speed: Annotated[str, typer.Option(
+        "--max-speed", help="Fastest speed to consider, deg/s unless a unit is written.")] = "180",
     poses: Annotated[int, typer.Option("--poses", help="--design poses: still poses.")] = 24,
     tilt: Annotated[float, typer.Option("--tilt", help="--design poses: tilt between successive poses [deg].")]
     = 90.0,
     still: Annotated[float, typer.Option("--still", help="--design poses: still time per pose [s].")] = 2.0,
-    peak_rate: Annotated[float, typer.Option(
-        "--peak-rate", help="--design poses: peak rate of each hand move [deg/s].")] = 150.0,
+    peak_rate: Annotated[str, typer.Option(
+        "--peak-rate", help="--design poses: peak rate of each hand move, deg/s unless a unit is written.")] = "150",
     accel_noise_density: Annotated[float, typer.Option(
         "--accel-noise-density", help="--design poses: accelerometer noise density [m/s^2/sqrt(Hz)] (MPU-6050: "
         "about 0.004).")] = 0.002,
@@ -93,6 +86,10 @@ def plan(
     from .._validation import positive
 
     refuse_unused(ctx, _DESIGN_FLAGS, design, "--design")
+    speed, max_speed, peak_rate = (in_unit(f"--{n}", v, "deg/s") for n, v in (
+        ("speed", speed), ("max-speed", max_speed), ("peak-rate", peak_rate)))
+    noise = in_unit("--noise", noise, "rad/s")
+    positive("speed", speed)
     positive("max_speed", max_speed)
     for name in ("target_scale", "target_cross", "target_accel_scale", "target_accel_offset"):
         if ctx.params[name] is not None:

@@ -14,7 +14,7 @@ import typer
 
 from ..choices import DeviceWire, Protocol, TimeStamps
 from ..errors import InputError
-from ._options import NoiseDensity, given, noise_std, numbers, refuse_unused, triple
+from ._options import NoiseDensity, given, in_unit, noise_std, numbers, refuse_unused, triple
 from ._outputs import check_output, json_format, starts_with
 from ._sim_device import refuse_device_flags, serve_device
 from ._sim_output import announce, output_unit, rate_flags, write_output
@@ -72,7 +72,8 @@ def simulate(
     bias_instability: Annotated[Optional[str], typer.Option(
         "--bias-instability", help="Gauss-Markov bias std, rad/s unless a unit is written (default: 0).")] = None,
     rate_random_walk: Annotated[Optional[str], typer.Option(
-        "--rrw", help="Rate random walk per sqrt(s), rad/s/sqrt(s) unless deg/s is written (default: 0).")] = None,
+        "--rrw", help="Rate random walk, rad/s/sqrt(s) unless a unit is written (0.01deg/s: deg/s/sqrt(s)) (default: "
+                      "0).")] = None,
     quantum: Annotated[Optional[str], typer.Option(
         "--quantum", help="Output resolution, rad/s unless a unit is written (default: none, not quantised).")] = None,
     full_scale: Annotated[Optional[str], typer.Option(
@@ -109,7 +110,8 @@ def simulate(
         "--temps", help="--protocol turntable: temperatures [degC], comma-separated (default: the full-temperature-"
                         "range method's Table 1, -40 to 50 by 10).")] = None,
     rates: Annotated[Optional[str], typer.Option(
-        "--rates", help="--protocol turntable: rates [deg/s], comma-separated, each run forward and reverse "
+        "--rates", help="--protocol turntable: rates, comma-separated, deg/s unless a unit is written after the "
+                        "last, each run forward and reverse "
                         "(default: the full-temperature-range method's Table 2, 0 to 400).")] = None,
     step_duration: Annotated[Optional[float], typer.Option(
         "--step-duration", help="--protocol turntable: length of each rate step [s] (default: 60, the paper's).")]
@@ -142,7 +144,7 @@ def simulate(
         "--units", help="Unit of the written gyro columns: deg/s, rad/s, or counts with --sensitivity.",
         metavar="<deg/s|rad/s|counts>")] = "deg/s",
     sensitivity: Annotated[Optional[float], typer.Option(
-        "--sensitivity", help="--units counts: LSB per deg/s of the written integers, e.g. 131 for an MPU-9250 at "
+        "--sensitivity", help="For --units counts: LSB per deg/s of the written integers, e.g. 131 for an MPU-9250 at "
                               "+-250 deg/s (required there; add --full-scale to clip at the sensor's range).")] = None,
     seed: Annotated[int, typer.Option("--seed", help="Random seed.", min=0)] = 0,
     reference: Annotated[Optional[Path], typer.Option(
@@ -155,8 +157,9 @@ def simulate(
     ref_mounting: Annotated[float, typer.Option(
         "--ref-mounting", help="Angle of the mounting rotation between the sensors [deg], axis drawn at random.")]
     = 0.0,
-    ref_noise: Annotated[Optional[float], typer.Option(
-        "--ref-noise", help="Reference white noise per sample [rad/s] (default: an ADIS16465, 0.0025 deg/s/sqrt(Hz)).")]
+    ref_noise: Annotated[Optional[str], typer.Option(
+        "--ref-noise", help="Reference white noise per sample, rad/s unless a unit is written (default: an "
+                            "ADIS16465, 0.0025 deg/s/sqrt(Hz)).")]
     = None,
     ref_units: Annotated[str, typer.Option("--ref-units", help="Unit of the reference's gyro columns.")] = "deg/s",
     force: Annotated[bool, typer.Option("--force", help="Replace an -o file that gyrocal simulate did not write.")]
@@ -221,7 +224,7 @@ def simulate(
     if reference is not None:
         ref_rec, facts["reference"] = _reference_log(rec.t, true_rates, reference, rng, sample_rate=ref_sample_rate,
                                                      offset=ref_offset, drift=ref_drift, mounting=ref_mounting,
-                                                     noise=ref_noise)
+                                                     noise=in_unit("--ref-noise", ref_noise, "rad/s"))
     if stamps == "receive" or gaps or given(ctx, "late_per_minute"):
         rec, facts = _time_defects(rec, facts, settings, stamps, late_per_minute, gaps, gap_length, reference, rng)
     write_output(output, rec, unit, sensitivity, settings, f"{_SIMULATED} --protocol {protocol}", large=bool(size))

@@ -10,7 +10,7 @@ import typer
 
 from ..choices import StudyName
 from ..errors import InputError
-from ._options import NoiseDensity, given, refuse_unused
+from ._options import given, in_unit, noise_density_option, refuse_unused
 from ._outputs import check_output
 from .app import app, console
 
@@ -36,11 +36,12 @@ def study(
     methods: Annotated[Optional[str], typer.Option(
         "--methods", help="servo-speed: estimators, comma-separated (algorithm1, lm, first-moment) (default: "
         "all three).")] = None,
-    noise_density: NoiseDensity = None,
+    noise_density: noise_density_option("the study's own noise levels apply") = None,
     sample_rate: Annotated[float, typer.Option(
         "--sample-rate", help="Sampling rate [Hz] (thermal-compare's default: 100).")] = 200.0,
-    speed: Annotated[float, typer.Option(
-        "--speed", help="Servo studies but servo-speed: turn speed [deg/s] (paper: 60).")] = 60.0,
+    speed: Annotated[str, typer.Option(
+        "--speed", help="Servo studies but servo-speed: turn speed, deg/s unless a unit is written (paper: 60).")]
+    = "60",
 ) -> None:
     """Run a Monte Carlo study of the servo method of Wang et al. or the full-temperature-range method."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
@@ -57,6 +58,7 @@ def study(
         if not options["methods"] or not set(options["methods"]) <= set(values(Method)):
             raise InputError(f"--methods takes a comma-separated list of {', '.join(values(Method))}, got "
                              f"{methods!r}")
+    speed = in_unit("--speed", speed, "deg/s")
     if not (math.isfinite(speed) and speed > 0):
         raise InputError(f"--speed must be > 0 deg/s, got {speed:g}")
     if not (math.isfinite(sample_rate) and sample_rate > 0):

@@ -13,7 +13,7 @@ import typer
 
 from ..choices import OutOfRange
 from ..errors import InputError
-from ._options import AcceptImplausible, judge_plausible
+from ._options import AcceptImplausible, in_unit, judge_plausible
 from ._outputs import check_output, refuse_swapped, same_document
 from ._reading import READING
 from ._station import StationFlags, conclude, finish, station_flags, write_and_store
@@ -25,8 +25,9 @@ __all__ = ["thermal", "thermal_report"]
 Units = Annotated[str, typer.Option("--units", help="Unit of the gyro and table_rate columns (required).",
                                     metavar="<rad/s|deg/s|counts>")]
 Settle = Annotated[float, typer.Option("--settle", help="Time dropped at the start of every step (s).")]
-FullScale = Annotated[Optional[float], typer.Option(
-    "--full-scale", help="Gyro range in the data's unit; steps with samples at it are left out (with a warning) "
+FullScale = Annotated[Optional[str], typer.Option(
+    "--full-scale", help="Gyro range, in the data's rate unit unless a unit is written (--units counts: counts, or "
+    "e.g. 250deg/s); steps with samples at it are left out (with a warning) "
     "(default: saturation found as runs of identical extreme readings).")]
 TempTol = Annotated[float, typer.Option(
     "--temp-tolerance", help="Spread allowed inside a step, and closest distinct temperature points (degC).")]
@@ -44,13 +45,17 @@ def _units(units: str, output_units: str | None, sensitivity: float | None) -> t
     return u, parse_rate_unit(output_units or u, "output_units")
 
 
-def _full_scale(value: float | None, units: str, rate_unit: str, sensitivity: float | None) -> float | None:
-    """--full-scale in rad/s (checked as the user typed it, in the data's unit)."""
+def _full_scale(text: str | None, units: str, rate_unit: str, sensitivity: float | None) -> float | None:
+    """--full-scale in rad/s (checked as the user typed it, in the data's unit unless a unit is written)."""
     from .._validation import positive
     from ..units import parse_input_unit, unit_factor
 
-    if value is None:
+    if text is None:
         return None
+    try:
+        value = float(text)
+    except ValueError:  # written with its unit
+        return positive("full_scale", in_unit("--full-scale", text, "rad/s"))
     value = positive("full_scale", value)
     if parse_input_unit(units) == "counts":
         return value / sensitivity * unit_factor(rate_unit)
@@ -74,7 +79,7 @@ def thermal(
     columns: READING.Columns = None,
     skip_rows: READING.SkipRows = None,
     sample_rate: READING.SampleRate = None,
-    sensitivity: READING.Sensitivity = None,
+    sensitivity: READING.SensitivityNeeded = None,
     settle: Settle = 2.0,
     full_scale: FullScale = None,
     temp_tolerance: TempTol = 2.0,
@@ -163,7 +168,7 @@ def thermal_report(
     columns: READING.Columns = None,
     skip_rows: READING.SkipRows = None,
     sample_rate: READING.SampleRate = None,
-    sensitivity: READING.Sensitivity = None,
+    sensitivity: READING.SensitivityOfCalibration = None,
     settle: Settle = 2.0,
     full_scale: FullScale = None,
     temp_tolerance: TempTol = 2.0,

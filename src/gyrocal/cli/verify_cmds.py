@@ -166,7 +166,7 @@ def verify(
     ref_columns: REF.Columns = None,
     ref_skip_rows: REF.SkipRows = None,
     ref_sample_rate: REF.SampleRate = None,
-    ref_sensitivity: REF.Sensitivity = None,
+    ref_sensitivity: REF.SensitivityDegS = None,
     ref_topic: REF.Topic = None,
     ref_saturation: REF.Saturation = "error",
     ref_no_unit_check: REF.NoUnitCheck = False,
