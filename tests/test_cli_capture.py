@@ -324,7 +324,7 @@ def _station_run(tmp_path, servo, *extra, answer=None, limits="min = 0.97\nmax =
     lim.write_text(f"guard = 2\n[limits.k]\n{limits}")
     with VirtualDevice(device_bytes(servo, "frames", encoder="c"), answer=answer) as dev:
         run = start(dev, "-o", tmp_path / "rec.csv", "--guide", "servo", "--unit", "SN-7", "--limits", lim,
-                    "--store", tmp_path / "station.db", "--write-back", *extra)
+                    "--store", tmp_path / "station.db", "--write-back", "--quiet", *extra)
         return (*run.finish(), json.loads((tmp_path / "rec.cal.json").read_text()))
 
 
