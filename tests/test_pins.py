@@ -253,3 +253,26 @@ def test_a_temperature_point_has_the_ols_standard_errors_with_n_minus_4_dof():
     _, rss, _, _ = np.linalg.lstsq(X, means, rcond=None)
     se = np.sqrt(np.outer(np.diag(np.linalg.inv(X.T @ X)), rss / (n - 4)))  # (4 parameters, 3 axes)
     np.testing.assert_allclose(np.sort(point.std.ravel()), np.sort(se.ravel()), rtol=1e-9)
+
+
+def test_quiet_noise_pools_unbiased_block_variances():
+    """Reference: the unbiased sample variance worked by hand: blocks of 8 samples alternating +1, -1 have
+    sum of squares 8 over 8 - 1 degrees of freedom, so the pooled noise is sqrt(8 / 7)."""
+    from gyrocal.observed import quiet_noise
+
+    x = np.tile([1.0, -1.0], 4 * 20)[:, None] * np.ones(3)  # 20 blocks of 8 at 16 Hz (half-second blocks)
+    np.testing.assert_allclose(quiet_noise(x, 16.0), math.sqrt(8 / 7), rtol=1e-12)
+
+
+@pytest.mark.parametrize("above, order", [(0.65, 1), (0.8, 2)])
+def test_the_smooth_model_takes_the_lowest_order_within_one_standard_error(monkeypatch, above, order):
+    """Reference: the one-standard-error rule with the LOTO RMS's relative uncertainty 1/sqrt(2n), n = 8
+    temperatures: order 1 at best x (1 + 0.65/sqrt(8)) is taken over a better order 2, at (1 + 0.8/sqrt(8)) not."""
+    from gyrocal.thermal import smooth
+
+    n = 8
+    best = 1.0
+    rms = np.array([[5.0], [best * (1 + above / math.sqrt(n))], [best], [best * 1.01]])
+    monkeypatch.setattr(smooth, "loto_errors", lambda t, y, top: rms[: top + 1])
+    model = smooth.fit_smooth(np.linspace(-40.0, 85.0, n), np.linspace(0.0, 1.0, n)[:, None], max_order=3)
+    assert int(model.orders[0]) == order
