@@ -108,12 +108,12 @@ def apply(
 
 
 def _check_observed(cal, rec, source: str, name: str) -> None:
-    """Warn of data unlike the calibration's; the scaled copy of the rates dies here, before correction."""
+    """Warn of data unlike the calibration's (read in its input unit: the rates times a scale, not a copy)."""
     from ..observed import check_observed
 
-    raw = rec.gyro / cal.input_scale if rec.units == "rad/s" else rec.gyro
-    note = check_observed(cal.observed, raw, rec.sample_rate, source=source, calibration=name,
-                          sensitivity=cal.sensitivity, output_units=cal.output_units)
+    scale = 1.0 / cal.input_scale if rec.units == "rad/s" else 1.0
+    note = check_observed(cal.observed, rec.gyro, rec.sample_rate, source=source, calibration=name,
+                          sensitivity=cal.sensitivity, output_units=cal.output_units, scale=scale)
     if note is not None:
         warn(note)
 
