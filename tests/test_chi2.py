@@ -4,10 +4,9 @@ import math
 
 import numpy as np
 import pytest
+import scipy.special as scipy_special
 
 from gyrocal._chi2 import chi2_sf
-
-scipy_special = pytest.importorskip("scipy.special")
 
 
 def test_matches_scipy_to_1e12_relative():
