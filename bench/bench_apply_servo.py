@@ -106,13 +106,18 @@ def main() -> None:
     parser.add_argument("--keep", type=Path, help="work folder to keep (default: a temporary one)")
     parser.add_argument("--stage", help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.stage == "prepare":
+        _prepare(args.keep, args.samples)
+        return
     if args.stage:
         print(json.dumps(stage(args.stage, args.keep)))
         return
     with tempfile.TemporaryDirectory() as tmp:
         work = args.keep or Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
-        _prepare(work, args.samples)
+        # a child inherits its parent's peak memory: the log is made in a process of its own too
+        subprocess.run([sys.executable, __file__, "--stage", "prepare", "--keep", str(work), "--samples",
+                        str(args.samples)], check=True)
         numbers = args.samples * 4 * 8 / 2**20
         print(f"log: {args.samples:,} rows, {(work / 'log.csv').stat().st_size / 2**20:.0f} MiB of CSV, "
               f"{numbers:.0f} MiB of numbers")
