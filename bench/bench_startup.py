@@ -5,6 +5,7 @@ Run by hand:  python bench/bench_startup.py [--repeat 5] [--previous-src DIR]
 Each command runs in a fresh interpreter (best of `repeat`), next to:
 
 * the bare interpreter (``python -c pass``): the floor no import can beat;
+* ``python -c "import numpy"``: the baseline of issue 25 (``calibrate --example`` at most 2.5x it);
 * the previous start: the same command after importing what the command line loaded before its
   imports became lazy (numpy and the modules the package root and the command modules imported at
   the top), kept here as the baseline; or, with ``--previous-src``, a checkout of an earlier gyrocal
@@ -43,15 +44,15 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--previous-src", help="src folder of an earlier gyrocal, run as the baseline")
     args = parser.parse_args()
-    floor = best("pass", args.repeat)
-    print(f"interpreter alone: {floor:.3f} s")
+    floor, numpy_start = best("pass", args.repeat), best("import numpy", args.repeat)
+    print(f"interpreter alone: {floor:.3f} s, with numpy imported {numpy_start:.3f} s")
     for argv in (["--help"], ["calibrate", "--example"]):
         now = best(RUN.format(argv=argv), args.repeat)
         before = (best(RUN.format(argv=argv), args.repeat, args.previous_src) if args.previous_src
                   else best(PREVIOUS + RUN.format(argv=argv), args.repeat))
         name = "gyrocal " + " ".join(argv)
         print(f"{name:>28}: now {now:.3f} s ({100 * floor / now:.0f} % interpreter), previous {before:.3f} s; "
-              f"previous / now {before / now:.2f}x")
+              f"previous / now {before / now:.2f}x; now / import numpy {now / numpy_start:.2f}x")
 
 
 if __name__ == "__main__":

@@ -144,13 +144,13 @@ def _solve_tau2(r2: np.ndarray, v: np.ndarray, c: np.ndarray, dof: float) -> flo
 
 def _beyond_noise(z2: np.ndarray, h: np.ndarray, n_rot: int, axis: np.ndarray) -> np.ndarray:
     """Which groups (turns; static levels of x, y, z) have a noise-only chi2 with p < `EVIDENCE_P` (4,)."""
-    from scipy.special import chdtrc
+    from ._chi2 import chi2_sf
 
     parts = [slice(0, n_rot)] + [n_rot + np.flatnonzero(axis == j) for j in range(3)]
     out = np.zeros(4, dtype=bool)
     for g, rows in enumerate(parts):
         dof = float(np.sum(1 - h[rows]))
-        out[g] = dof > 0.5 and float(chdtrc(dof, float(np.sum(z2[rows])))) < EVIDENCE_P
+        out[g] = dof > 0.5 and float(chi2_sf(dof, float(np.sum(z2[rows])))) < EVIDENCE_P
     return out
 
 

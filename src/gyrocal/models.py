@@ -57,7 +57,16 @@ def kb_to_kg(K, B) -> np.ndarray:
 def correct(matrix: np.ndarray, offset: np.ndarray, readings) -> np.ndarray:
     """Apply ``w_true = matrix @ (m - offset)`` to readings of shape (..., 3) [reading units]."""
     m = finite_array("readings", readings, shape_tail=(3,))
-    return rows_times(m - offset, matrix)
+    if m.ndim != 2 or len(m) <= _CHUNK_ROWS:
+        return rows_times(m - offset, matrix)
+    out = np.empty(m.shape)
+    for s in range(0, len(m), _CHUNK_ROWS):  # bounded temporaries: a long log is not held twice more
+        out[s:s + _CHUNK_ROWS] = rows_times(m[s:s + _CHUNK_ROWS] - offset, matrix)
+    return out
+
+
+#: Rows corrected at a time by :func:`correct`.
+_CHUNK_ROWS = 1 << 16
 
 
 @dataclass(frozen=True)

@@ -58,11 +58,11 @@ def observe(raw: np.ndarray, sample_rate: float, units: str) -> dict:
             "max_abs_rate": np.max(np.abs(raw), axis=0).tolist(), "units": units}
 
 
-def _ratio(observed, raw: np.ndarray, sample_rate: float) -> tuple[float, np.ndarray, np.ndarray]:
-    """Median over axes of the noise ratio (data / calibration), and both noise levels."""
+def _ratio(observed, raw: np.ndarray, sample_rate: float, scale: float) -> tuple[float, np.ndarray, np.ndarray]:
+    """Median over axes of the noise ratio (data times `scale` / calibration), and both noise levels."""
     # the calibration's quiet noise, measured as here; else the noise behind its 1-sigma
     then = np.asarray(observed.get("quiet_noise_std") or observed["noise_std"], dtype=float)
-    now = quiet_noise(raw, sample_rate)
+    now = quiet_noise(raw, sample_rate) * abs(scale)
     ok = (then > 0) & (now > 0)  # quantised quiet data can read zero: no evidence
     return (float(np.median(now[ok] / then[ok])) if ok.any() else math.nan), now, then
 
@@ -72,7 +72,8 @@ def _near(ratio: float, factor: float) -> bool:
 
 
 def check_observed(observed, raw: np.ndarray, sample_rate: float, *, source: str, calibration: str,
-                   sensitivity: float | None = None, output_units: str | None = None) -> str | None:
+                   sensitivity: float | None = None, output_units: str | None = None,
+                   scale: float = 1.0) -> str | None:
     """Refuse data that look like another unit than the calibration's; return a warning for data
     whose noise differs from the calibration's by more than a factor 8 without a unit to explain it.
 
@@ -89,6 +90,8 @@ def check_observed(observed, raw: np.ndarray, sample_rate: float, *, source: str
         Names of the data and of the calibration file, for the message.
     sensitivity, output_units : optional
         The calibration's sensitivity [LSB per `output_units`], when its input is counts.
+    scale : float
+        Factor taking `raw` to the calibration's input unit (no scaled copy of a long log is made).
 
     Returns
     -------
@@ -103,11 +106,13 @@ def check_observed(observed, raw: np.ndarray, sample_rate: float, *, source: str
     units = observed["units"]
     raw = np.asarray(raw, dtype=float)
     if len(raw) and np.all(raw == raw[0]):
-        return (f"{source}: every reading is the same ({_shown(raw[0])} {units}): the sensor was not running, or the "
-                "columns are not the gyro's; the corrected file holds nothing but the calibration's offsets")
-    q, now, then = _ratio(observed, raw, sample_rate)
+        return (f"{source}: every reading is the same ({_shown(raw[0] * scale)} {units}): the sensor was not running, "
+                "or the columns are not the gyro's; the corrected file holds nothing but the calibration's offsets")
+    q, now, then = _ratio(observed, raw, sample_rate, scale)
     if not math.isfinite(q) or 1 / _SAME <= q <= _SAME:
         return None
+    if scale != 1.0:
+        raw = raw * scale  # a warning or a refusal follows: the copy is worth its cost here
     peak_now = np.max(np.abs(raw), axis=0)
     peak_then = np.asarray(observed["max_abs_rate"], dtype=float)
     r = float(np.median(peak_now / np.where(peak_then > 0, peak_then, np.nan))) if (peak_then > 0).any() else math.nan

@@ -132,9 +132,9 @@ def _name(i: int, label: str, z: Sequence[float]) -> str:
 
 def _group_p(groups) -> list[tuple[str, float, float, float]]:
     """``(name, chi2, dof, p)`` of each group with degrees of freedom."""
-    from scipy.special import chdtrc
+    from ._chi2 import chi2_sf
 
-    return [(g.name, g.chi2, g.dof, float(chdtrc(g.dof, g.chi2))) for g in groups if g.dof > 0.5]
+    return [(g.name, g.chi2, g.dof, float(chi2_sf(g.dof, g.chi2))) for g in groups if g.dof > 0.5]
 
 
 def assess_fit(residuals: Sequence[Sequence[float]], labels: Sequence[str], n_params: int, *,
@@ -160,7 +160,7 @@ def assess_fit(residuals: Sequence[Sequence[float]], labels: Sequence[str], n_pa
     excess_document : dict, optional
         Their record for the file (:meth:`gyrocal.excess.Excess.to_document`).
     """
-    from scipy.special import chdtrc  # the chi-square survival function, without scipy.stats's import
+    from ._chi2 import chi2_sf  # the chi-square survival function without scipy's import
 
     z = [np.asarray(r, dtype=float).ravel() for r in residuals]
     per_window = np.array([float(np.dot(r, r)) for r in z])
@@ -172,7 +172,7 @@ def assess_fit(residuals: Sequence[Sequence[float]], labels: Sequence[str], n_pa
         note = (f"no residual degrees of freedom: {rows} equations for {n_params} parameters, so nothing checks "
                 f"{what} against each other; add static windows or repeat turns to let the fit check itself")
         return GoodnessOfFit(chi2, 0, None, None, False, tuple(labels), zs, (), (note,))
-    p = float(chdtrc(dof, chi2))
+    p = float(chi2_sf(dof, chi2))
     birge = math.sqrt(chi2 / dof)
     groups = _group_p(excess.groups) if excess is not None else []
     doc = excess_document

@@ -96,13 +96,7 @@ def apply(
         console.print(f"note: {recording.name} has no ax ay az: the gyro is corrected, the calibration's "
                       "accelerometer part is not used", highlight=False, soft_wrap=True)
     if not no_unit_check and getattr(cal, "observed", None) is not None:
-        from ..observed import check_observed
-
-        raw = rec.gyro / cal.input_scale if rec.units == "rad/s" else rec.gyro
-        note = check_observed(cal.observed, raw, rec.sample_rate, source=recording.name, calibration=calibration.name,
-                              sensitivity=cal.sensitivity, output_units=cal.output_units)
-        if note is not None:
-            warn(note)
+        _check_observed(cal, rec, recording.name, calibration.name)
     options = {name: value for name, value in (("model", model), ("out_of_range", out_of_range))
                if given(ctx, name)}
     corrected = cal.apply(rec, **options)
@@ -111,6 +105,17 @@ def apply(
     note = f"{_APPLIED} with {Path(calibration).name}; gx gy gz in {out_units}{accel}"
     write_recording(output, corrected, header_comment=note)
     console.print(f"wrote {output} ({len(corrected)} rows, gx gy gz in {out_units})", highlight=False)
+
+
+def _check_observed(cal, rec, source: str, name: str) -> None:
+    """Warn of data unlike the calibration's (read in its input unit: the rates times a scale, not a copy)."""
+    from ..observed import check_observed
+
+    scale = 1.0 / cal.input_scale if rec.units == "rad/s" else 1.0
+    note = check_observed(cal.observed, rec.gyro, rec.sample_rate, source=source, calibration=name,
+                          sensitivity=cal.sensitivity, output_units=cal.output_units, scale=scale)
+    if note is not None:
+        warn(note)
 
 
 def _from_store(url: str, serial: str | None, recording: Path, at: str | None):

@@ -165,8 +165,8 @@ def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool
 
 
 def _read_arrow(path: Path, packed: str | None, layout: Layout, mapping: dict, encoding: str) -> dict:
-    """Columns of a text table through pyarrow's streaming reader: each block of rows becomes numpy pieces
-    as it is parsed, so memory holds the numbers (twice while they are joined), not pyarrow's whole table."""
+    """Columns of a text table through pyarrow: all numbers at once (:func:`_filled`), else through the
+    streaming reader, each block of rows becoming numpy pieces as it is parsed (joined at the end)."""
     import pyarrow as pa
     import pyarrow.csv as pcsv
 
@@ -174,28 +174,32 @@ def _read_arrow(path: Path, packed: str | None, layout: Layout, mapping: dict, e
 
     names = layout.names
     numeric = [mapping[c] for c in NUMERIC if c in mapping]
-    axis = mapping.get("axis")
+    axis, rates = mapping.get("axis"), [mapping[c] for c in ("gx", "gy", "gz")]
 
-    def read(as_float: bool, encoding: str = "utf8") -> dict[str, list]:
+    def read(as_float: bool, encoding: str = "utf8") -> dict[str, np.ndarray]:
         types = {n: (pa.float64() if as_float and n in numeric else pa.string()) for n in names}
         pieces: dict[str, list] = {n: [] for n in names}
+        all_numbers = all(t == pa.float64() for t in types.values())
+        # pyarrow's 1 MiB blocks for numbers (larger ones cost memory and time); fewer for text's per-block work
+        block = {} if all_numbers else {"block_size": 1 << 22}
         options = {
             # our stripped names replace the header row
-            "read_options": pcsv.ReadOptions(skip_rows=layout.data, column_names=names, encoding=encoding,
-                                             block_size=1 << 24),
+            "read_options": pcsv.ReadOptions(skip_rows=layout.data, column_names=names, encoding=encoding, **block),
             "parse_options": pcsv.ParseOptions(delimiter=layout.delimiter, ignore_empty_lines=True),
             "convert_options": pcsv.ConvertOptions(column_types=types, strings_can_be_null=False,
                                                    decimal_point="," if layout.decimal_comma else "."),
         }
         with arrow_input(path, packed) as source:
-            # numbers only: the whole table at once, its blocks parsed on every core (the streaming reader
-            # parses on one); the numbers are held once by pyarrow and once joined, as when streamed
-            all_numbers = all(t == pa.float64() for t in types.values())
-            batches = pcsv.read_csv(source, **options).to_batches() if all_numbers else pcsv.open_csv(source, **options)
-            for batch in batches:
+            if all_numbers:
+                # numbers only: the whole table at once, its blocks parsed on every core (the streaming
+                # reader parses on one)
+                return _filled(pcsv.read_csv(source, **options), names, rates)
+            for batch in pcsv.open_csv(source, **options):
                 for n, column in zip(names, batch.columns):
                     pieces[n].append(_piece(column, n))
-        return pieces
+        cols = _joined(pieces, rates, axis)
+        pa.default_memory_pool().release_unused()  # pyarrow's allocator keeps freed blocks
+        return cols
 
     def _piece(column, name: str):
         if pa.types.is_floating(column.type):
@@ -206,8 +210,7 @@ def _read_arrow(path: Path, packed: str | None, layout: Layout, mapping: dict, e
     as_float, encoding = True, "utf8" if encoding == "utf-8-sig" else encoding
     for _ in range(3):
         try:
-            pieces = read(as_float, encoding)
-            break
+            return read(as_float, encoding)
         except pa.ArrowInvalid as exc:
             message = str(exc)
             if "invalid UTF8" in message and encoding == "utf8":
@@ -216,10 +219,33 @@ def _read_arrow(path: Path, packed: str | None, layout: Layout, mapping: dict, e
                 as_float = False  # cells need trimming or hold text: parse them in numpy
             else:
                 raise InputError(f"{path.name}: cannot parse the table ({message.splitlines()[0]})") from None
-    else:
-        raise InputError(f"{path.name}: cannot parse the table")
-    cols = _joined(pieces, [mapping[c] for c in ("gx", "gy", "gz")], axis)
-    pa.default_memory_pool().release_unused()  # pyarrow's allocator keeps freed blocks; the rest of the run needs them
+    raise InputError(f"{path.name}: cannot parse the table")
+
+
+def _filled(table, names: list[str], rates: list[str]) -> dict[str, np.ndarray]:
+    """The columns of an all-numbers table in arrays of their own, the rates in one (3, N) block.
+
+    Each record batch goes once copied, in the order pyarrow allocated them, so its allocator frees
+    whole regions as the arrays fill: the numbers are held about once, not once by pyarrow and once copied.
+    """
+    import pyarrow as pa
+
+    from ._arrow import numeric_to_numpy
+
+    n, pool = table.num_rows, pa.default_memory_pool()
+    block = np.empty((3, n))
+    cols = {name: (block[rates.index(name)] if name in rates else np.empty(n)) for name in names}
+    batches = table.to_batches()[::-1]
+    del table
+    pos = 0
+    while batches:
+        batch = batches.pop()
+        for name, column in zip(names, batch.columns):
+            numeric_to_numpy(column, out=cols[name][pos:pos + len(batch)])
+        pos += len(batch)
+        del batch, column
+        if len(batches) % 16 == 0:
+            pool.release_unused()
     return cols
 
 

@@ -72,8 +72,13 @@ def write_csv(path: str | os.PathLike, columns: dict, *, header_comment: str | N
     progress : callable, optional
         Called with the number of rows written after each chunk (a progress bar).
     """
+    _write(path, _columns(columns), {}, header_comment, progress)
+
+
+def _write(path, arrays: dict[str, np.ndarray], divisors: dict[str, float], header_comment: str | None,
+           progress) -> None:
+    """:func:`write_csv` of checked columns, those in `divisors` divided by theirs a chunk at a time."""
     check_csv_name(path)
-    arrays = _columns(columns)
     n = len(next(iter(arrays.values())))
     with atomic_path(path) as tmp:
         with open(tmp, "w", encoding="utf-8", newline="") as f:
@@ -82,7 +87,8 @@ def write_csv(path: str | os.PathLike, columns: dict, *, header_comment: str | N
         write_chunk = _arrow_chunk_writer()
         with open(tmp, "ab") as f:
             for start in range(0, n, CHUNK_ROWS):
-                write_chunk(f, {k: v[start:start + CHUNK_ROWS] for k, v in arrays.items()})
+                chunk = {k: v[start:start + CHUNK_ROWS] for k, v in arrays.items()}
+                write_chunk(f, {k: (v / divisors[k] if k in divisors else v) for k, v in chunk.items()})
                 if progress is not None:
                     progress(min(CHUNK_ROWS, n - start))
 
@@ -132,6 +138,12 @@ def recording_columns(rec, units: str | None = None) -> dict[str, np.ndarray]:
     in the gyro's unit (deg/s beside raw counts), ``axis``, ``ax ay az`` [m/s^2] (raw
     counts stay counts), then every other column unchanged.
     """
+    cols, divisors = _recording_columns(rec, units)
+    return {k: (v / divisors[k] if k in divisors else v) for k, v in cols.items()}
+
+
+def _recording_columns(rec, units: str | None) -> tuple[dict[str, np.ndarray], dict[str, float]]:
+    """The recording's columns in its own units, and the divisor that takes each to the written unit."""
     if rec.units == "counts":
         if units not in (None, "counts"):
             raise InputError(f"the recording holds raw counts; it cannot be written in {units}", param="units")
@@ -143,14 +155,16 @@ def recording_columns(rec, units: str | None = None) -> dict[str, np.ndarray]:
                              param="units")
         gyro_factor = unit_factor(table_unit)
     cols: dict[str, np.ndarray] = {}
+    divisors = dict.fromkeys(("gx", "gy", "gz"), gyro_factor) if gyro_factor != 1.0 else {}
     if rec.has_time:
         cols["t"] = np.asarray(rec.t)
     for i, name in enumerate(("gx", "gy", "gz")):
-        cols[name] = rec.gyro[:, i] / gyro_factor if gyro_factor != 1.0 else rec.gyro[:, i]
+        cols[name] = rec.gyro[:, i]
     if rec.temp is not None:
         cols["temp"] = rec.temp
     if rec.table_rate is not None:
-        cols["table_rate"] = rec.table_rate / unit_factor(table_unit)
+        cols["table_rate"] = rec.table_rate
+        divisors["table_rate"] = unit_factor(table_unit)
     if rec.axis is not None:
         cols["axis"] = rec.axis
     if rec.accel is not None:
@@ -158,11 +172,12 @@ def recording_columns(rec, units: str | None = None) -> dict[str, np.ndarray]:
             cols[name] = rec.accel[:, i]
     for name, value in rec.extra.items():
         cols.setdefault(name, value)
-    return cols
+    return cols, divisors
 
 
 def write_recording(path: str | os.PathLike, rec, *, units: str | None = None,
                     header_comment: str | None = None, progress=None) -> None:
     """Write a recording as CSV (:func:`recording_columns`), atomically, with an optional ``#`` comment
     (`progress` as for :func:`write_csv`)."""
-    write_csv(path, recording_columns(rec, units), header_comment=header_comment, progress=progress)
+    cols, divisors = _recording_columns(rec, units)  # converted a chunk at a time: no whole converted copy
+    _write(path, _columns(cols), divisors, header_comment, progress)
