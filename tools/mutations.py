@@ -105,7 +105,7 @@ MUTATIONS = [
              "least-delayed level at the fifth, not tenth, quantile",
              ("tests/test_timebase.py", "tests/test_fast_paths.py")),
     # MAD and stillness
-    Mutation("mad-constant", S + "units.py", "MAD_TO_SIGMA = ", "MAD_TO_SIGMA = 1.01 * ", "MAD factor x 1.01",
+    Mutation("mad-constant", S + "constants.py", "MAD_TO_SIGMA = ", "MAD_TO_SIGMA = 1.01 * ", "MAD factor x 1.01",
              ("tests/test_pins.py",)),
     Mutation("stillness-jump", S + "stillness.py", "nsigma * np.sqrt(2.0) * scale", "nsigma * scale",
              "a jump between blocks judged without sqrt 2", ("tests/test_stillness.py",)),
