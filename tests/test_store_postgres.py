@@ -6,7 +6,6 @@ References: a port nothing listens on (tests/pg_server.free_port), PostgreSQL's 
 
 from __future__ import annotations
 
-import time
 from datetime import UTC, datetime
 
 import psycopg
@@ -19,14 +18,12 @@ from gyrocal.store import open_store
 
 def test_an_unreachable_server_is_one_clear_line():
     url = f"postgresql://gyrocal:hunter2@127.0.0.1:{free_port()}/nothing"
-    start = time.perf_counter()
     with pytest.raises(StoreError) as caught:
         open_store(url)
     message = str(caught.value)
     assert message.startswith(f"cannot reach store postgresql://gyrocal:***@127.0.0.1:{url.split(':')[3]}")
     assert "refused" in message.lower() and "\n" not in message and "hunter2" not in message
     assert caught.value.__cause__ is None and caught.value.__suppress_context__
-    assert time.perf_counter() - start < 15
 
 
 def test_a_missing_database_is_one_clear_line(pg_server):
