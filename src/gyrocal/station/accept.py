@@ -22,7 +22,7 @@ _AXES = "xyz"
 
 @dataclass(frozen=True)
 class Criterion:
-    """One value judged against one bound, in the bound's unit."""
+    """One value judged against one bound, in the bound's unit; `parameter` names the limit (k, b, ...)."""
 
     name: str
     value: float
@@ -31,6 +31,7 @@ class Criterion:
     high: float
     unit: str
     guard: float
+    parameter: str = ""
 
     @property
     def margin(self) -> float:
@@ -46,7 +47,7 @@ class Criterion:
         def finite(x):
             return x if math.isfinite(x) else None
 
-        return {"name": self.name, "value": finite(self.value), "sigma": finite(self.sigma), "low": finite(self.low),
+        return {"name": self.name, "parameter": self.parameter, "value": finite(self.value), "sigma": finite(self.sigma), "low": finite(self.low),
                 "high": finite(self.high), "unit": self.unit, "guard": self.guard, "margin": finite(self.margin),
                 "verdict": "pass" if self.passed else "fail"}
 
@@ -152,7 +153,7 @@ def measured(doc: dict) -> dict[str, list[tuple[str, float, float]]]:
 
 def _criterion(bound: Bound, name: str, value: float, sigma: float, guard: float) -> Criterion:
     low, high = bound.interval()
-    return Criterion(name, value / bound.scale, sigma / bound.scale, low, high, bound.unit, guard)
+    return Criterion(name, value / bound.scale, sigma / bound.scale, low, high, bound.unit, guard, bound.parameter)
 
 
 def accept(doc: dict, limits: Limits) -> Acceptance:

@@ -30,17 +30,10 @@ def _num(x, digits: int = 6) -> str:
     return "-" if x is None or (isinstance(x, float) and not math.isfinite(x)) else f"{x:.{digits}g}"
 
 
-def _parameter_of(name: str) -> str:
-    for key in sorted(_REQUIREMENT, key=len, reverse=True):
-        if name == key or name.startswith(key + "_") or (len(name) == len(key) + 1 and name.startswith(key)):
-            return key
-    return "misalignment" if name.startswith("K") else name
-
-
 def _results(doc: dict) -> list[dict]:
     acc = doc.get("acceptance") or {}
     test = _TEST.get(doc.get("format"), doc.get("format", ""))
-    return [{"requirement": f"{_REQUIREMENT.get(_parameter_of(c['name']), c['name'])} ({c['name']})", "test": test,
+    return [{"requirement": f"{_REQUIREMENT.get(c.get('parameter', ''), c['name'])} ({c['name']})", "test": test,
              "value": _num(c["value"]), "sigma": _num(c["sigma"], 3), "low": _num(c["low"]), "high": _num(c["high"]),
              "unit": c["unit"], "margin": _num(c["margin"], 3), "verdict": c["verdict"].upper()}
             for c in acc.get("criteria", [])]
