@@ -164,3 +164,26 @@ def test_too_few_temperature_points_is_one_line_error():
     with pytest.raises(InputError, match="3 or more temperature points") as err:
         calibrate_imu_thermal(t[keep], gyro[keep], accel[keep], temp[keep], breaks=breaks[:1], min_plateau=10.0)
     assert "\n" not in str(err.value)
+
+
+def test_a_chamber_recording_writes_the_thermal_section_and_old_files_still_load(tmp_path):
+    """calibrate_recording finds the breaks and plateaus itself; the file holds the points and both models."""
+    from gyrocal.calibration import Calibration
+    from gyrocal.imu.run import calibrate_recording
+    from gyrocal.recording import Recording
+
+    truth, _, t, gyro, accel, temp, _ = _chamber(7, poses=12)
+    rec = Recording(t=t, gyro=gyro, accel=accel, accel_units="m/s^2", accel_source_units="m/s^2",
+                    source_units="rad/s", temp=temp)
+    run = calibrate_recording(rec)
+    assert run.thermal is not None and len(run.thermal.points) == len(TEMPS)
+    doc = run.calibration.to_document()
+    section = doc["accelerometer"]["thermal"]
+    assert section["points"][section["reference_point"]]["temperature"] == pytest.approx(20.0, abs=0.1)
+    assert len(section["accelerometer"]["smooth"]["coefs"]) == 9 and "frame" in section
+    loaded = Calibration.from_document(doc)
+    assert loaded.accelerometer["thermal"]["accelerometer"]["names"][0] == "A_xx"
+    a_ref, o_ref = truth.accel(run.thermal.points[run.thermal.reference].temperature)
+    np.testing.assert_allclose(doc["accelerometer"]["correction"]["offset"], o_ref, atol=0.02)
+    del doc["accelerometer"]["thermal"]
+    assert "thermal" not in Calibration.from_document(doc).accelerometer
