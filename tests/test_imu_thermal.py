@@ -187,3 +187,26 @@ def test_a_chamber_recording_writes_the_thermal_section_and_old_files_still_load
     np.testing.assert_allclose(doc["accelerometer"]["correction"]["offset"], o_ref, atol=0.02)
     del doc["accelerometer"]["thermal"]
     assert "thermal" not in Calibration.from_document(doc).accelerometer
+
+
+def test_apply_corrects_both_sensors_at_each_samples_temperature():
+    """Reference: the generator's truth at 30 degC, between the points; apply with the file beats the point at 20."""
+    from gyrocal.calibration import Calibration
+    from gyrocal.imu.run import calibrate_recording
+    from gyrocal.recording import Recording
+
+    truth, _, t, gyro, accel, temp, _ = _chamber(8, poses=12)
+    rec = Recording(t=t, gyro=gyro, accel=accel, accel_units="m/s^2", accel_source_units="m/s^2",
+                    source_units="rad/s", temp=temp)
+    cal = Calibration.from_document(calibrate_recording(rec).calibration.to_document())
+    f = 9.80665 * fibonacci_directions(30)
+    a, o = truth.accel(30.0)
+    u = f @ np.linalg.inv(a).T + o
+    test = Recording(t=np.arange(len(u)) * 0.01, gyro=np.zeros((len(u), 3)), accel=u, accel_units="m/s^2",
+                     accel_source_units="m/s^2", source_units="rad/s", temp=np.full(len(u), 30.0))
+    thermal = cal.apply(test).accel
+    single = cal.apply(Recording(t=test.t, gyro=test.gyro, accel=u, accel_units="m/s^2",
+                                 accel_source_units="m/s^2", source_units="rad/s")).accel
+    err_t, err_1 = (float(np.sqrt(np.mean(np.sum((x - f) ** 2, axis=1)))) for x in (thermal, single))
+    assert err_t < 0.01 < err_1 and err_t < err_1 / 10
+    assert np.all(np.isfinite(cal.apply(test).gyro))

@@ -33,7 +33,7 @@ from .plateaus import Plateau, find_plateaus, temperature_points
 from .session import ImuCalibrationResult, calibrate_imu
 from .thermal_model import TemperatureModel, temperature_model
 
-__all__ = ["FRAME", "ImuPoint", "ImuThermalResult", "calibrate_imu_thermal"]
+__all__ = ["FRAME", "ImuPoint", "ImuThermalResult", "calibrate_imu_thermal", "correct_with_section"]
 
 FRAME = ("accelerometer: the 9-parameter model's frame at each temperature (corrected x along the sensor's x "
          "axis, y in the sensor's xy plane; scale-bias: the sensor's axes); gyro: onto the corrected accelerometer "
@@ -226,3 +226,32 @@ def calibrate_imu_thermal(t, gyro, accel, temp, *, gravity: float = STANDARD_GRA
     ref = int(np.argmin(np.abs(np.array(nodes) - 25.0)))
     return ImuThermalResult(points=points, accel_model=am, gyro_model=gm, accel=a_model, gyro=g_model,
                             reference=ref, notes=tuple(notes))
+
+
+def _smooth_values(doc, temp: np.ndarray) -> np.ndarray:
+    """Parameters (N, m) of a file's smooth model (``accelerometer.thermal.<sensor>``), the temperature clamped
+    to the points' range."""
+    smooth = doc["smooth"]
+    nodes = np.asarray(doc["points"]["temperature"], dtype=float)
+    u = (np.clip(temp, nodes.min(), nodes.max()) - float(smooth["centre"])) / float(smooth["scale"])
+    coefs = np.asarray(smooth["coefs"], dtype=float)
+    return np.vander(u, coefs.shape[1], increasing=True) @ coefs.T
+
+
+def correct_with_section(doc, gyro, accel, temp) -> tuple[np.ndarray, np.ndarray]:
+    """Both sensors corrected by a file's ``accelerometer.thermal`` section at each sample's temperature.
+
+    `gyro` and `accel` are in the section's ``internal`` units; returns rates [rad/s] and specific
+    force [m/s^2]. The smooth model is used, its temperature clamped to the points' range (a
+    polynomial is not extrapolated).
+    """
+    temp = np.asarray(temp, dtype=float)
+    a_doc, g_doc = doc["accelerometer"], doc["gyro"]
+    p = _smooth_values(a_doc, temp)
+    force = np.einsum("nij,nj->ni", model_matrices(a_doc["model"], p), np.asarray(accel, dtype=float) - p[:, -3:])
+    q = _smooth_values(g_doc, temp)
+    mask = MASKS[g_doc["model"]]
+    k = int(mask.sum())
+    a = np.zeros((len(q), 3, 3))
+    a[:, mask] = q[:, :k]
+    return np.einsum("nij,nj->ni", a, np.asarray(gyro, dtype=float) - q[:, k:k + 3]), force
