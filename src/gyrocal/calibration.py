@@ -184,7 +184,21 @@ class Calibration:
             coupling = self.accelerometer.gyro_coupling(fields.get("accel"))
             if coupling is not None:  # the gyro's g-sensitivity, in input units
                 fields["gyro"] = self.model.correct(raw - coupling * self.input_scale)
+            fields.update(self._thermal_fields(rec, raw))
         return replace(rec, **fields)
+
+    def _thermal_fields(self, rec: Recording, raw) -> dict[str, Any]:
+        """Both sensors corrected at each sample's temperature by ``accelerometer.thermal`` (none: no change)."""
+        thermal = self.accelerometer.get("thermal")
+        if thermal is None or rec.temp is None:
+            return {}
+        if rec.accel_units != thermal["internal"]["accelerometer"]:
+            raise UnitError(f"the accelerometer's model in temperature takes {thermal['internal']['accelerometer']} "
+                            f"but the recording's accelerometer is in {rec.accel_units}", param="accel_units")
+        from .imu.thermal import correct_with_section
+
+        gyro, accel = correct_with_section(thermal, raw, rec.accel, rec.temp)
+        return {"gyro": gyro, "accel": accel}
 
     def c_header(self, prefix: str = "gyrocal") -> str:
         """Firmware header for ``gyrocal_correct`` (see :func:`gyrocal.firmware.header.calibration_header`)."""

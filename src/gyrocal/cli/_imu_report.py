@@ -148,3 +148,19 @@ def print_imu_run(run, windows_from: str = "--windows") -> None:
     _print_poses(run, windows_from)
     _print_accel(run)
     _print_gyro(run)
+    _print_thermal(run)
+
+
+def _print_thermal(run) -> None:
+    """The temperature points and the smooth models' orders, when the log held several points."""
+    th = getattr(run, "thermal", None)
+    if th is None:
+        return
+    temps = ", ".join(f"{p.temperature:.1f} ({p.poses} poses)" for p in th.points)
+    console.print(f"across temperature: {len(th.points)} points at {temps} degC; file section accelerometer.thermal",
+                  highlight=False, soft_wrap=True, markup=False)
+    for name, model in (("accelerometer", th.accel), ("gyro", th.gyro)):
+        orders = ", ".join(f"{n} {int(o)}" for n, o in zip(model.names, model.smooth.orders))
+        console.print(f"  {name}: smooth polynomial orders {orders} (and 3-node Lagrange)", highlight=False,
+                      soft_wrap=True, markup=False)
+    console.print(f"  frame: {th.to_dict()['frame']}", highlight=False, soft_wrap=True, markup=False)

@@ -42,6 +42,7 @@ __all__ = [
     "AccelModel",
     "directions_of",
     "fit_accelerometer",
+    "model_matrices",
     "normal_gravity",
     "param_names",
 ]
@@ -151,6 +152,14 @@ class AccelFit:
         value, std = _propagate(figures, self.params, self.covariance)
         names = ("sens_x", "sens_y", "sens_z", "angle_xy", "angle_xz", "angle_yz")
         return {k: (float(v), float(s)) for k, v, s in zip(names, value, std)}
+
+
+def model_matrices(model: AccelModel, params) -> np.ndarray:
+    """Matrices ``A`` (N, 3, 3) of `model` from parameter rows (N, p) ordered as :func:`param_names`."""
+    p = np.atleast_2d(np.asarray(params, dtype=float))
+    a = np.zeros((len(p), 3, 3))
+    a[:, _MASKS[model]] = p[:, : _MASKS[model].sum()]
+    return a
 
 
 def _matrix(model: AccelModel, p: np.ndarray) -> np.ndarray:

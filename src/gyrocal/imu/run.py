@@ -6,7 +6,11 @@ times, leaving out pose pairs across lost samples) and builds the
 :class:`~gyrocal.calibration.Calibration`: ``correction`` and ``parameters`` are the gyro's, in
 the conventions of the other methods (``w_true = matrix @ (raw - offset)``), and the
 ``accelerometer`` section holds the accelerometer's correction, its parameters with their
-covariance, how well they fit, the poses, and the gyro's g-sensitivity when it was fitted.
+covariance, how well they fit, the poses, and the gyro's g-sensitivity when it was fitted. A log
+whose temperature column spans several points (a chamber's plateaus) is calibrated at each point
+(:mod:`gyrocal.imu.thermal`): the correction is then the point nearest 25 degC, and
+``accelerometer.thermal`` holds both sensors at every point, their Lagrange and smooth models in
+temperature with 1-sigma, the frame they write in, and ``internal``: the units of their parameters.
 """
 
 from __future__ import annotations
@@ -24,6 +28,7 @@ from ..timebase import TimeBase
 from ..units import STANDARD_GRAVITY, accel_scale, parse_rate_unit
 from .filedoc import accelerometer_section, gyro_fit_section
 from .session import ImuCalibrationResult, calibrate_imu
+from .thermal import ImuThermalResult, calibrate_imu_thermal
 
 __all__ = ["ImuRun", "accel_scale", "calibrate_recording", "implausible", "plausibility"]
 
@@ -31,6 +36,8 @@ ACCEL_OUTPUT_UNITS = ("m/s^2", "g")
 #: A gap of at most this many lost samples is integrated across (its trapezoid error is third order in
 #: its length, below the noise of a hand move); a pose pair across a longer one is left out.
 MAX_LOST = 2
+#: A temperature column spanning more than this is taken as a chamber log of several temperature points [degC].
+THERMAL_SPAN = 5.0
 
 
 @dataclass(frozen=True)
@@ -44,11 +51,14 @@ class ImuRun:
     calibration : Calibration
         The calibration file's content.
     time_base : TimeBase
+    thermal : ImuThermalResult or None
+        Both sensors across temperature, when the log holds poses at 3 or more temperature points.
     """
 
     result: ImuCalibrationResult
     calibration: Calibration
     time_base: TimeBase
+    thermal: ImuThermalResult | None = None
 
     @property
     def warnings(self) -> tuple[str, ...]:
@@ -135,11 +145,38 @@ def calibrate_recording(rec: Recording, *, windows=None, gravity: float = STANDA
                                 "output_units")
     tb = rec.time_base()
     clock = tb.clock_times()
-    result = calibrate_imu(rec.t if clock is None else clock, rec.gyro, rec.accel, gravity=gravity, windows=windows,
-                           accel_model=accel_model, gyro_model=gyro_model, g_sensitivity=g_sensitivity,
-                           min_static=min_static, gaps=[g.index for g in tb.gaps if g.lost > MAX_LOST],
-                           breaks=tb.breaks, threshold=threshold)
-    return ImuRun(result, _calibration(result, rec, tb, out_units, accel_output_units, gravity), tb)
+    kw = {"gravity": gravity, "accel_model": accel_model, "gyro_model": gyro_model, "min_static": min_static,
+          "gaps": [g.index for g in tb.gaps if g.lost > MAX_LOST], "breaks": tb.breaks, "threshold": threshold}
+    t = rec.t if clock is None else clock
+    thermal, result = _thermal(rec, t, kw) if windows is None and not g_sensitivity else (None, None)
+    if result is None:
+        result = calibrate_imu(t, rec.gyro, rec.accel, windows=windows, g_sensitivity=g_sensitivity, **kw)
+    cal = _calibration(result, rec, tb, out_units, accel_output_units, gravity)
+    if thermal is not None:
+        part = {**cal.accelerometer, "thermal": {**thermal.to_dict(), "internal": {
+            "accelerometer": rec.accel_units, "gyro": "counts" if rec.source_units == "counts" else "rad/s"}}}
+        cal = replace(cal, accelerometer=part)
+    return ImuRun(result, cal, tb, thermal)
+
+
+def _thermal(rec: Recording, t, kw) -> tuple[ImuThermalResult | None, ImuCalibrationResult | None]:
+    """Both sensors across temperature when the temperature column spans several points, and the result at the
+    point nearest 25 degC (the file's correction); a span that gives no model is said in that result's warnings."""
+    if rec.temp is None or np.ptp(rec.temp) <= THERMAL_SPAN:
+        return None, None
+    try:
+        thermal = calibrate_imu_thermal(t, rec.gyro, rec.accel, rec.temp, **kw)
+    except InputError as exc:
+        result = calibrate_imu(t, rec.gyro, rec.accel, **kw)
+        why = (f"the temperature column spans {np.ptp(rec.temp):.1f} degC but no model in temperature was fitted "
+               f"({exc}); the correction is one fit over all the poses")
+        return None, replace(result, warnings=result.warnings + (why,))
+    ref = thermal.points[thermal.reference]
+    result = max(ref.results, key=lambda r: len(r.statics))
+    what = (f"{len(thermal.points)} temperature points ({', '.join(f'{p.temperature:.1f}' for p in thermal.points)} "
+            f"degC): the correction is the point at {ref.temperature:.1f} degC, accelerometer.thermal holds both "
+            "sensors at every point and their models in temperature")
+    return thermal, replace(result, warnings=result.warnings + thermal.notes + (what,))
 
 
 def _gyro_model(result: ImuCalibrationResult):

@@ -19,7 +19,7 @@ from .._arrays import readonly
 from .._validation import finite_array
 from ..errors import InputError
 
-__all__ = ["SmoothModel", "fit_smooth", "loto_errors"]
+__all__ = ["SmoothModel", "fit_smooth", "loto_errors", "weighted_coefficients"]
 
 
 def _vander(u: np.ndarray, order: int) -> np.ndarray:
@@ -122,3 +122,55 @@ def fit_smooth(temps, values, max_order: int = 3) -> SmoothModel:
     for j, p in enumerate(orders):
         coefs[j, : p + 1] = np.linalg.lstsq(_vander(u, int(p)), y[:, j], rcond=None)[0]
     return SmoothModel(centre=centre, scale=scale, orders=orders, coefs=coefs, loto_rms=rms)
+
+
+def weighted_coefficients(model: SmoothModel, temps, values, covariances) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Refit `model`'s polynomials (its orders kept) weighted by each point's 1-sigma, with their covariance.
+
+    Each column ``j`` of `values` gets ``c_j = (V^T W_j V)^-1 V^T W_j y_j`` with ``W_j`` the inverse
+    variances of that column at the points; the coefficients are linear in all values, so the
+    points' full covariances (correlations between the columns at one point included; points
+    independent of one another) carry through exactly.
+
+    Parameters
+    ----------
+    model : SmoothModel
+        Gives the orders and the temperature normalisation.
+    temps : array_like, shape (n,)
+        Point temperatures [degC].
+    values : array_like, shape (n, m)
+    covariances : array_like, shape (n, m, m)
+        Of each point's values.
+
+    Returns
+    -------
+    coefs : ndarray, shape (m, P + 1)
+        As :attr:`SmoothModel.coefs`, zero above each column's order.
+    covariance : ndarray, shape (m * (P + 1), m * (P + 1))
+        Of ``coefs.ravel()``.
+    chi2 : ndarray, shape (m,)
+        Weighted residual sum of squares of each column (``n - order - 1`` degrees of freedom).
+    """
+    t = finite_array("temps", temps, ndim=1)
+    y = finite_array("values", values, ndim=2)
+    cov = finite_array("covariances", covariances, ndim=3)
+    n, m = y.shape
+    if cov.shape != (n, m, m) or len(t) != n:
+        raise InputError(f"need {n} temperatures and covariances of shape ({n}, {m}, {m}), got {len(t)} and "
+                         f"{cov.shape}")
+    sigma = np.sqrt(np.einsum("nii->ni", cov))
+    if np.any(sigma <= 0):
+        raise InputError("every point's values need a 1-sigma > 0 to weight the smooth fit")
+    u = (t - model.centre) / model.scale
+    width = model.coefs.shape[1]
+    gain = np.zeros((m * width, n * m))  # coefs.ravel() = gain @ values.ravel()
+    chi2 = np.empty(m)
+    for j, p in enumerate(model.orders):
+        v = _vander(u, int(p)) / sigma[:, j:j + 1]
+        g = np.linalg.pinv(v) / sigma[:, j]
+        gain[j * width:j * width + int(p) + 1, j::m] = g
+        chi2[j] = float(np.sum(((y[:, j] - _vander(u, int(p)) @ (g @ y[:, j])) / sigma[:, j]) ** 2))
+    block = np.zeros((n * m, n * m))
+    for k in range(n):
+        block[k * m:(k + 1) * m, k * m:(k + 1) * m] = cov[k]
+    return (gain @ y.ravel()).reshape(m, width), gain @ block @ gain.T, chi2
