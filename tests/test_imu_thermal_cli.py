@@ -6,7 +6,7 @@ readings of known specific forces, without noise, so what is left after ``apply`
 
 import numpy as np
 import pytest
-from cli_runner import invoke
+from cli_runner import invoke, refused
 from imu_chamber import TEMPS, Truth, chamber
 
 from gyrocal.files import load
@@ -89,3 +89,10 @@ def test_apply_between_the_points_is_the_truth_within_the_models_sigma(chamber_r
     print(f"apply at {BETWEEN_T} degC: RMS error {err_rms:.2e} m/s^2, RMS z {rms_z:.2f}")
     assert rms_z < 2.5  # one board: the model's error is one draw, shared by every direction
     assert err_rms < 0.01
+
+
+def test_thermal_report_refuses_an_imu_thermal_calibration_in_one_line(chamber_run, tmp_path):
+    """thermal-report evaluates a turntable gyro table; an IMU file is named as such, with what to use instead."""
+    _, d, cal, _ = chamber_run
+    line = refused("thermal-report", cal, d / "chamber.csv", "-o", tmp_path / "report")
+    assert "IMU thermal calibration" in line and "gyrocal thermal" in line and "gyrocal apply" in line
