@@ -4,11 +4,15 @@ Reference: the independent generator of :mod:`imu_chamber`; the test log at 30 d
 readings of known specific forces, without noise, so what is left after ``apply`` is the model's error.
 """
 
+import ctypes
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from cli_runner import invoke, refused
 from imu_chamber import TEMPS, Truth, chamber
 
+from gyrocal import firmware
 from gyrocal.files import load
 from gyrocal.imu.accel import model_matrices
 from gyrocal.imu.poses import fibonacci_directions
@@ -96,3 +100,34 @@ def test_thermal_report_refuses_an_imu_thermal_calibration_in_one_line(chamber_r
     _, d, cal, _ = chamber_run
     line = refused("thermal-report", cal, d / "chamber.csv", "-o", tmp_path / "report")
     assert "IMU thermal calibration" in line and "gyrocal thermal" in line and "gyrocal apply" in line
+
+
+def test_c_header_imu_thermal_table_matches_python_apply(chamber_run, tmp_path):
+    """Reference: Python's Calibration.apply with the temperature column; the C library reads the header that
+    ``export --format c-header`` writes and corrects each sample at its temperature (float32)."""
+    _, d, cal_path, _ = chamber_run
+    header = tmp_path / "imu_cal.h"
+    code, _, err = invoke("export", cal_path, "--format", "c-header", "-o", header)
+    assert code == 0, err
+    assert "GYROCAL_IMU_THERMAL" in header.read_text()
+    src = tmp_path / "driver.c"
+    src.write_text('#include "imu_cal.h"\nint drive(float temp, const float g[3], const float a[3], float w[3], '
+                   "float f[3])\n{ return gyrocal_imu_thermal_correct(&GYROCAL_IMU_THERMAL, temp, g, a, w, f); }\n")
+    dll = firmware.load_library(tmp_path / "build", extra_sources=[src], include_dirs=[tmp_path]).dll
+    dll.drive.argtypes = [ctypes.c_float] + [ctypes.POINTER(ctypes.c_float)] * 4
+    data = read_recording(d / "chamber.csv", units="deg/s", accel_units="m/s^2")
+    step = slice(None, None, 53)
+    g_raw = np.ascontiguousarray(data.gyro[step], dtype=np.float32)  # rad/s: the section's internal unit
+    a_raw = np.ascontiguousarray(data.accel[step], dtype=np.float32)
+    temp = data.temp[step].astype(np.float32)
+    temp[:5] = [-40.0, 0.0, 30.0, 55.0, 80.0]  # between the points and beyond them (clamped)
+    w, f = np.empty_like(g_raw), np.empty_like(a_raw)
+    ptr = ctypes.POINTER(ctypes.c_float)
+    for i in range(len(g_raw)):
+        assert dll.drive(float(temp[i]), *(x[i].ctypes.data_as(ptr) for x in (g_raw, a_raw, w, f))) == 0
+    sub = replace(data, t=data.t[step], gyro=g_raw.astype(float), accel=a_raw.astype(float), temp=temp.astype(float))
+    ours = load(cal_path).apply(sub)
+    eps = np.finfo(np.float32).eps
+    # float32: a few roundings of terms the size of the readings, offsets and polynomial terms (u up to 1)
+    np.testing.assert_allclose(f, ours.accel, atol=40 * eps * 10.0)
+    np.testing.assert_allclose(w, ours.gyro, atol=40 * eps * (1.0 + np.abs(g_raw).max()))
