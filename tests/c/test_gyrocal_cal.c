@@ -234,12 +234,52 @@ static void test_solvers(void)
     CHECK(gyrocal_algorithm1(obs, &out, &it) == GYROCAL_E_INPUT && untouched(out.k, 3));
 }
 
+static void test_poly_correct(void)
+{
+    /* matrix(T) = diag(1 + u, 2, 3 - u^3), offset(T) = (u^2, 0, 1), u = (T - 10) / 20, T clamped to [-10, 50] */
+    gyrocal_imu_thermal_t imu;
+    float raw[3] = {1.0f, 2.0f, 3.0f}, out[3], w[3], a[3];
+    int e, k;
+    for (e = 0; e < 12; ++e) {
+        for (k = 0; k <= GYROCAL_POLY_MAX_ORDER; ++k) {
+            imu.accel.coefs[e][k] = 0.0f;
+        }
+    }
+    imu.accel.tmin = -10.0f;
+    imu.accel.tmax = 50.0f;
+    imu.accel.centre = 10.0f;
+    imu.accel.scale = 20.0f;
+    imu.accel.coefs[0][0] = 1.0f;
+    imu.accel.coefs[0][1] = 1.0f;
+    imu.accel.coefs[4][0] = 2.0f;
+    imu.accel.coefs[8][0] = 3.0f;
+    imu.accel.coefs[8][3] = -1.0f;
+    imu.accel.coefs[9][2] = 1.0f;
+    imu.accel.coefs[11][0] = 1.0f;
+    imu.gyro = imu.accel;
+    CHECK(gyrocal_poly_correct(&imu.accel, 30.0f, raw, out) == GYROCAL_OK); /* u = 1 */
+    CHECK(close_to(out[0], 0.0f, 1e-6f) && close_to(out[1], 4.0f, 1e-6f) && close_to(out[2], 4.0f, 1e-6f));
+    CHECK(gyrocal_poly_correct(&imu.accel, 90.0f, raw, out) == GYROCAL_OK); /* clamped to 50: u = 2 */
+    CHECK(close_to(out[0], -9.0f, 1e-6f) && close_to(out[2], -10.0f, 1e-6f));
+    CHECK(gyrocal_imu_thermal_correct(&imu, 30.0f, raw, raw, w, a) == GYROCAL_OK);
+    CHECK(close_to(w[1], 4.0f, 1e-6f) && close_to(a[2], 4.0f, 1e-6f));
+    fill(out, 3);
+    CHECK(gyrocal_poly_correct(&imu.accel, NAN, raw, out) == GYROCAL_E_INPUT && untouched(out, 3));
+    CHECK(gyrocal_poly_correct(0, 30.0f, raw, out) == GYROCAL_E_INPUT && untouched(out, 3));
+    imu.gyro.scale = 0.0f;
+    fill(w, 3);
+    fill(a, 3);
+    CHECK(gyrocal_imu_thermal_correct(&imu, 30.0f, raw, raw, w, a) == GYROCAL_E_INPUT && untouched(w, 3) &&
+          untouched(a, 3));
+}
+
 int main(void)
 {
     test_status_codes();
     test_correct();
     test_scale_bias_to_affine();
     test_thermal_correct();
+    test_poly_correct();
     test_singular_table();
     test_temp_filter();
     test_accumulator();

@@ -106,6 +106,56 @@ gyrocal_status_t gyrocal_imu_correct(const gyrocal_imu_t *imu, const float gyro_
     return GYROCAL_OK;
 }
 
+gyrocal_status_t gyrocal_poly_correct(const gyrocal_poly_affine_t *p, float temp, const float raw[3], float out[3])
+{
+    float v[12], d[3], u;
+    int e, k, i;
+    if (p == 0 || raw == 0 || out == 0 || !isfinite(temp) || !finite3(raw) || !isfinite(p->tmin) ||
+        !isfinite(p->tmax) || !(p->tmin <= p->tmax) || !isfinite(p->centre) || !(p->scale > 0.0f)) {
+        return GYROCAL_E_INPUT;
+    }
+    temp = temp < p->tmin ? p->tmin : (temp > p->tmax ? p->tmax : temp);
+    u = (temp - p->centre) / p->scale;
+    for (e = 0; e < 12; ++e) {
+        /* Horner's rule, highest power first */
+        float acc = p->coefs[e][GYROCAL_POLY_MAX_ORDER];
+        for (k = GYROCAL_POLY_MAX_ORDER - 1; k >= 0; --k) {
+            acc = acc * u + p->coefs[e][k];
+        }
+        v[e] = acc;
+    }
+    for (i = 0; i < 3; ++i) {
+        d[i] = raw[i] - v[9 + i];
+    }
+    for (i = 0; i < 3; ++i) {
+        out[i] = v[3 * i] * d[0] + v[3 * i + 1] * d[1] + v[3 * i + 2] * d[2];
+    }
+    return GYROCAL_OK;
+}
+
+gyrocal_status_t gyrocal_imu_thermal_correct(const gyrocal_imu_thermal_t *imu, float temp, const float gyro_raw[3],
+                                             const float accel_raw[3], float w_out[3], float a_out[3])
+{
+    float a[3], w[3];
+    gyrocal_status_t s;
+    int i;
+    if (imu == 0 || gyro_raw == 0 || accel_raw == 0 || w_out == 0 || a_out == 0) {
+        return GYROCAL_E_INPUT;
+    }
+    s = gyrocal_poly_correct(&imu->accel, temp, accel_raw, a);
+    if (s == GYROCAL_OK) {
+        s = gyrocal_poly_correct(&imu->gyro, temp, gyro_raw, w);
+    }
+    if (s != GYROCAL_OK) {
+        return s;
+    }
+    for (i = 0; i < 3; ++i) {
+        a_out[i] = a[i];
+        w_out[i] = w[i];
+    }
+    return GYROCAL_OK;
+}
+
 gyrocal_status_t gyrocal_scale_bias_to_affine(const gyrocal_scale_bias_t *sb, gyrocal_affine_t *out)
 {
     int i, j;

@@ -74,6 +74,24 @@ typedef struct {
     float g_sens[3][3];
 } gyrocal_imu_t;
 
+/* One sensor's correction as polynomials in temperature (gyrocal imu's smooth model, accelerometer.thermal):
+ *     out = matrix(T) (raw - offset(T)),   entry_e(T) = sum_p coefs[e][p] u^p,
+ *     u = (clamp(T, tmin, tmax) - centre) / scale,
+ * entries e: the 9 matrix elements row-major, then the 3 offsets; entries a model lacks are zero polynomials.
+ * The temperature is always clamped to [tmin, tmax] (the calibrated points): a polynomial is not extrapolated. */
+#define GYROCAL_CAL_HAS_IMU_THERMAL 1
+#define GYROCAL_POLY_MAX_ORDER 3
+typedef struct {
+    float tmin, tmax, centre, scale;
+    float coefs[12][GYROCAL_POLY_MAX_ORDER + 1];
+} gyrocal_poly_affine_t;
+
+/* A whole IMU across temperature: both sensors as gyrocal_poly_affine_t (no g-sensitivity term). */
+typedef struct {
+    gyrocal_poly_affine_t gyro;
+    gyrocal_poly_affine_t accel;
+} gyrocal_imu_thermal_t;
+
 /* Parameters of the servo method of Wang et al.: g = diag(k) (m + b); b in the sensor's units, added to the reading. */
 typedef struct {
     float k[3];
@@ -119,6 +137,14 @@ gyrocal_status_t gyrocal_correct(const gyrocal_affine_t *cal, const float raw[3]
  * a_out and w_out may be the inputs. */
 gyrocal_status_t gyrocal_imu_correct(const gyrocal_imu_t *imu, const float gyro_raw[3], const float accel_raw[3],
                                      float w_out[3], float a_out[3]);
+
+/* out = matrix(T) (raw - offset(T)) of a gyrocal_poly_affine_t; out may be raw. GYROCAL_E_INPUT on a NaN or
+ * infinite temperature or reading, tmin > tmax or a scale that is not positive. */
+gyrocal_status_t gyrocal_poly_correct(const gyrocal_poly_affine_t *p, float temp, const float raw[3], float out[3]);
+
+/* Both sensors of a gyrocal_imu_thermal_t at temperature temp [degC]; the outputs may be the inputs. */
+gyrocal_status_t gyrocal_imu_thermal_correct(const gyrocal_imu_thermal_t *imu, float temp, const float gyro_raw[3],
+                                             const float accel_raw[3], float w_out[3], float a_out[3]);
 
 /* The canonical form of the servo method's parameters (Wang et al.): matrix = diag(k), offset = -b. */
 gyrocal_status_t gyrocal_scale_bias_to_affine(const gyrocal_scale_bias_t *sb, gyrocal_affine_t *out);

@@ -158,6 +158,28 @@ def _print_table(cal, fit) -> None:
                   + " ".join(map(str, cal.smooth.orders.tolist())))
 
 
+def _load_table(path: Path, load_thermal):
+    """The gyro thermal table of `path`; an IMU thermal calibration (``gyrocal imu``) is refused in one line
+    naming what the report evaluates."""
+    from ..errors import FileFormatError, GyrocalError
+
+    try:
+        return load_thermal(path)
+    except FileFormatError:
+        from ..files import load_correction
+
+        try:
+            other = load_correction(path)
+        except (GyrocalError, OSError, ValueError):  # the first error is the one to show
+            other = None
+        if (getattr(other, "accelerometer", None) or {}).get("thermal") is not None:
+            raise InputError(f"{path} is an IMU thermal calibration (gyrocal imu, accelerometer.thermal); "
+                             "thermal-report evaluates only a gyro table from 'gyrocal thermal' on a turntable test "
+                             "log (table_rate steps); check an IMU one with 'gyrocal apply' at the test "
+                             "temperatures") from None
+        raise
+
+
 @app.command("thermal-report")
 def thermal_report(
     calibration: Annotated[Path, typer.Argument(help="Thermal calibration file from 'gyrocal thermal'.")],
@@ -184,7 +206,7 @@ def thermal_report(
 
     refuse_swapped(calibration, test, command="thermal-report", usage="thermal file from 'gyrocal thermal' comes")
     check_output(output, inputs=(calibration, test), folder=True)
-    cal = load_thermal(calibration)
+    cal = _load_table(calibration, load_thermal)
     units = units or cal.input_units
     with warnings_as_lines():
         recs, _ = _read(test, units, columns, sample_rate, sensitivity, cal.output_units if units == "counts" else None,

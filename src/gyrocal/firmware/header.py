@@ -22,6 +22,9 @@ __all__ = ["C_LIBRARY_VERSION", "c_prefix", "calibration_header", "thermal_heade
 #: ``GYROCAL_CAL_VERSION`` of the C library these headers are written for (gyrocal_cal.h).
 C_LIBRARY_VERSION = 2
 
+#: ``GYROCAL_POLY_MAX_ORDER`` of gyrocal_cal.h: the highest power of a temperature polynomial it evaluates.
+_POLY_MAX_ORDER = 3
+
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
 
@@ -116,6 +119,10 @@ def calibration_header(cal, *, prefix: str = "gyrocal") -> str:
         imu_comment, imu_body = _imu_part(cal, c_prefix(prefix), matrix, offset)
         comment += ["", *imu_comment]
         body += "\n" + imu_body
+        if cal.accelerometer.get("thermal") is not None:
+            th_comment, th_body = _imu_thermal_part(cal.accelerometer["thermal"], c_prefix(prefix))
+            comment += ["", *th_comment]
+            body += "\n" + th_body
     return _header(name, comment, cal.input_units, cal.output_units, body)
 
 
@@ -153,6 +160,67 @@ def _imu_part(cal, upper: str, matrix, offset) -> tuple[list[str], str]:
         + f"    {_affine_literal(matrix, offset, 8)},\n"
         + f"    {_affine_literal(a_matrix, a_offset, 8)},\n"
         + "    {\n" + ",\n".join(f"        {_c_vector(row)}" for row in g_sens) + "\n    }\n"
+        + "};\n"
+    )
+    return comment, body
+
+
+def _poly_entries(doc, matrices) -> np.ndarray:
+    """Coefficients (12, GYROCAL_POLY_MAX_ORDER + 1) of one sensor's smooth model as matrix entries (row-major)
+    and offsets; `matrices` maps parameter rows (n, m) to (matrix (n, 3, 3), offset (n, 3)), linear in them."""
+    coefs = np.asarray(doc["smooth"]["coefs"], dtype=float)  # (m, P + 1)
+    if coefs.shape[1] > _POLY_MAX_ORDER + 1:
+        raise InputError(f"the smooth model has order {coefs.shape[1] - 1}; the C library takes up to "
+                         f"{_POLY_MAX_ORDER} (fit with max_order {_POLY_MAX_ORDER} or less)")
+    matrix, offset = matrices(coefs.T)  # one row per power
+    entries = np.zeros((12, _POLY_MAX_ORDER + 1))
+    entries[:9, : coefs.shape[1]] = matrix.reshape(-1, 9).T
+    entries[9:, : coefs.shape[1]] = offset.T
+    return entries
+
+
+def _poly_literal(doc, matrices, indent: str) -> str:
+    """A gyrocal_poly_affine_t initialiser of one sensor of ``accelerometer.thermal``."""
+    nodes = np.asarray(doc["points"]["temperature"], dtype=float)
+    head = [nodes.min(), nodes.max(), float(doc["smooth"]["centre"]), float(doc["smooth"]["scale"])]
+    rows = ",\n".join(f"{indent}    {_c_vector(row)}" for row in _poly_entries(doc, matrices))
+    return f"{{\n{indent}{', '.join(_c_float(v) for v in head)},\n{indent}{{\n{rows}\n{indent}}}\n{indent[:-4]}}}"
+
+
+def _imu_thermal_part(section, upper: str) -> tuple[list[str], str]:
+    """Comment lines and the ``<PREFIX>_IMU_THERMAL`` definition (a gyrocal_imu_thermal_t) of the smooth models
+    of ``accelerometer.thermal``, in the section's internal units (what ``apply`` corrects with)."""
+    from ..imu.thermal import sensor_matrices
+
+    a_doc, g_doc = section["accelerometer"], section["gyro"]
+
+    def accel(rows):
+        return sensor_matrices(section, "accelerometer", rows)
+
+    def gyro(rows):
+        return sensor_matrices(section, "gyro", rows)
+
+    name = f"{upper}_IMU_THERMAL"
+    units = section["internal"]
+    lo, hi = (f(a_doc["points"]["temperature"]) for f in (min, max))
+    comment = [
+        f"Whole IMU across temperature (accelerometer.thermal, smooth model): gyrocal_imu_thermal_correct(&{name},",
+        "  temp_degC, gyro_raw, accel_raw, w_true, a_true), the same correction as gyrocal apply:",
+        "  each sensor out = matrix(T) (raw - offset(T)), entries polynomials in u = (T - centre) / scale,",
+        f"  T clamped to the points' range [{lo:.2f}, {hi:.2f}] degC (no extrapolation); no g-sensitivity term.",
+        f"  gyro_raw in {units['gyro']} -> w_true in rad/s; accel_raw in {units['accelerometer']} -> a_true in m/s^2.",
+        f"  Frame: {section['frame']}.",
+        f"  Accelerometer model {a_doc['model']}, gyro model {g_doc['model']}; 1-sigma in the calibration file.",
+    ]
+    body = (
+        "#ifndef GYROCAL_CAL_HAS_IMU_THERMAL\n"
+        + f'#error "{name}: needs a gyrocal_cal.h with gyrocal_imu_thermal_correct; take the one of this gyrocal"\n'
+        + "#endif\n"
+        + f'#define {name}_GYRO_INPUT_UNITS "{units["gyro"]}"\n'
+        + f'#define {name}_ACCEL_INPUT_UNITS "{units["accelerometer"]}"\n'
+        + f"static const gyrocal_imu_thermal_t {name} = {{\n"
+        + f"    {_poly_literal(g_doc, gyro, ' ' * 8)},\n"
+        + f"    {_poly_literal(a_doc, accel, ' ' * 8)}\n"
         + "};\n"
     )
     return comment, body

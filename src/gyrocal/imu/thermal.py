@@ -33,7 +33,7 @@ from .plateaus import Plateau, find_plateaus, temperature_points
 from .session import ImuCalibrationResult, calibrate_imu
 from .thermal_model import TemperatureModel, temperature_model
 
-__all__ = ["FRAME", "ImuPoint", "ImuThermalResult", "calibrate_imu_thermal", "correct_with_section"]
+__all__ = ["FRAME", "ImuPoint", "ImuThermalResult", "calibrate_imu_thermal", "correct_with_section", "sensor_matrices"]
 
 FRAME = ("accelerometer: the 9-parameter model's frame at each temperature (corrected x along the sensor's x "
          "axis, y in the sensor's xy plane; scale-bias: the sensor's axes); gyro: onto the corrected accelerometer "
@@ -238,6 +238,20 @@ def _smooth_values(doc, temp: np.ndarray) -> np.ndarray:
     return np.vander(u, coefs.shape[1], increasing=True) @ coefs.T
 
 
+def sensor_matrices(section, sensor: str, params) -> tuple[np.ndarray, np.ndarray]:
+    """Matrices (N, 3, 3) and offsets (N, 3) of `sensor` (``accelerometer`` or ``gyro``) of a file's
+    ``accelerometer.thermal`` section from parameter rows (N, m) in its names' order; linear in the rows."""
+    p = np.atleast_2d(np.asarray(params, dtype=float))
+    doc = section[sensor]
+    if sensor == "gyro":
+        mask = MASKS[doc["model"]]
+        k = int(mask.sum())
+        a = np.zeros((len(p), 3, 3))
+        a[:, mask] = p[:, :k]
+        return a, p[:, k:k + 3]
+    return model_matrices(doc["model"], p), p[:, -3:]
+
+
 def correct_with_section(doc, gyro, accel, temp) -> tuple[np.ndarray, np.ndarray]:
     """Both sensors corrected by a file's ``accelerometer.thermal`` section at each sample's temperature.
 
@@ -246,12 +260,8 @@ def correct_with_section(doc, gyro, accel, temp) -> tuple[np.ndarray, np.ndarray
     polynomial is not extrapolated).
     """
     temp = np.asarray(temp, dtype=float)
-    a_doc, g_doc = doc["accelerometer"], doc["gyro"]
-    p = _smooth_values(a_doc, temp)
-    force = np.einsum("nij,nj->ni", model_matrices(a_doc["model"], p), np.asarray(accel, dtype=float) - p[:, -3:])
-    q = _smooth_values(g_doc, temp)
-    mask = MASKS[g_doc["model"]]
-    k = int(mask.sum())
-    a = np.zeros((len(q), 3, 3))
-    a[:, mask] = q[:, :k]
-    return np.einsum("nij,nj->ni", a, np.asarray(gyro, dtype=float) - q[:, k:k + 3]), force
+    out = []
+    for sensor, raw in (("gyro", gyro), ("accelerometer", accel)):
+        a, offset = sensor_matrices(doc, sensor, _smooth_values(doc[sensor], temp))
+        out.append(np.einsum("nij,nj->ni", a, np.asarray(raw, dtype=float) - offset))
+    return out[0], out[1]
