@@ -22,25 +22,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import stages
 from .calibration import Calibration
-from .errors import InputError
-from .estimators import FitResult, make_estimator
-from .fit_checks import check_fit, single_turn_warnings, with_common_scale
-from .noise_terms import noise_notes, sigma_covers, white_floor, with_earth_rate
-from .observations import Observation, ObservationSet
+from .estimators import FitResult
+from .noise_terms import sigma_covers, white_floor
+from .observations import Observation
 from .observed import quiet_noise
-from .plausibility import Context, implausible
 from .quality import GoodnessOfFit
 from .recording import Recording
-from .screening import reference_variances, require_constant_rate, screen_breaks, screen_gaps
-from .segmentation import Segmentation, given_windows, segment
+from .screening import reference_variances
+from .segmentation import Segmentation
 from .timebase import TimeBase
-from .turn_angle import follow_wander
-from .units import input_scale, parse_input_unit, parse_rate_unit, unit_factor
+from .units import unit_factor
 from .window_stats import observe_windows
 from .windows import Window
 
-__all__ = ["CalibrationRun", "calibrate", "parameter_rows"]
+__all__ = ["CalibrationRun", "calibrate", "observations", "parameter_rows", "result"]
 
 
 @dataclass(frozen=True)
@@ -219,95 +216,80 @@ def calibrate(
         When the windows the method needs are not there; the message lists what was found.
     InputError
         For Algorithm 1 and LM, a rotation window whose rate varies (ramps, hand turns).
+
+    Notes
+    -----
+    The stages (:mod:`gyrocal.stages`) run in order: request, windows, time base, usable windows,
+    observations, fit, checks, uncertainty, :func:`result`. The options that reach more than one:
+
+    * `checks`: screens given windows (windows), reads the time base (so turns across gaps are
+      bounded), refuses varying rates for the paper's methods (usable windows), follows a wandering
+      axis on whole turns (fit, first-moment), runs the checks, adds the Earth's rate (uncertainty)
+      and writes the file's sections (result).
+    * `method`: which windows are usable (static ones for first-moment only), and the long-run
+      observations and wander following are first-moment only.
+    * `reference_sd`: per turn for an angle (observations), common to every plateau for a speed
+      (uncertainty), and a note (checks).
+    * `noise_std`: the estimator's noise, a floor on the observations' white level, and notes.
     """
-    # long function: the pipeline's steps in the order they run (references, segmentation, time base,
-    # observations, fit, checks, file sections), each already a call of its own
-    if (speed is None) == (angle is None):
-        raise InputError(f"give exactly one of speed [rad/s] or angle [rad], got speed={speed!r}, angle={angle!r}")
-    reference = "speed" if speed is not None else "angle"
-    value = abs(float(speed if speed is not None else angle))
-    if not (math.isfinite(value) and value > 0):
-        raise InputError(f"{reference} must be a finite non-zero number, got {value!r}")
-    for name, given in (("noise_std", noise_std), ("reference_sd", reference_sd)):
-        if given is not None and method != "first-moment":
-            raise InputError(f"{{param}} applies to method 'first-moment' only, got method={method!r}", param=name)
-    if noise_std is not None and not np.all(np.asarray(noise_std, dtype=float) > 0):
-        raise InputError(f"{{param}} must be > 0 on every axis, got {noise_std!r}: a zero noise would give a zero "
-                         "1-sigma", param="noise_std", value=noise_std,
-                         hint="measure it (gyrocal noise) or leave {param} out to estimate it from the windows")
-    estimator = make_estimator(method, **({} if noise_std is None else {"noise_std": noise_std}))
-    input_units = parse_input_unit(rec.source_units, "recording source_units")
-    out_units = parse_rate_unit(output_units or ("deg/s" if input_units == "counts" else input_units), "output_units")
-    if windows is None:
-        seg = segment(rec, reference=reference, speed=speed, angle=value, require=False)
-    else:
-        seg = given_windows(rec, windows, reference, value if reference == "speed" else None,
-                            value if reference == "angle" else None, screen=checks)
-    tb = rec.time_base() if checks else None
-    angle_var: dict = {}
-    # the sensor's clock under receive-time stamps: without gaps its trapezoid weights are even (a window
-    # lasts count x period), so only a clock with gaps needs its sample times rebuilt
-    period = tb.clock_period if tb is not None and tb.regular_clock and not tb.gaps else None
-    times = tb.clock_times() if tb is not None and tb.gaps else None
-    seg = screen_breaks(seg, rec.breaks if tb is None else tb.breaks)
-    if tb is not None:
-        seg, angle_var = screen_gaps(seg, rec, tb, reference, times)
-    uses_static = method == "first-moment"
-    seg.require(static_allowed=uses_static, min_rotations=0 if uses_static else 6)
-    used = seg.windows if uses_static else seg.rotations
-    if checks and not uses_static:
-        require_constant_rate(rec, used, seg.baseline, method)
-    observations = observe_windows(rec, used, reference, value, long_run=long_run and uses_static,
-                                   ripple=long_run and uses_static, times=times, period=period)
-    if noise_std is not None:  # the given white level is a floor; the data's long-run correlation still counts
-        observations = white_floor(observations, noise_std)
-    # turns across a time-stamp gap (their rate known within its bound), and the reference's declared accuracy
-    rel_var = reference_variances(used, reference, value, reference_sd if reference == "angle" else None, angle_var)
-    observations = tuple(dataclasses.replace(o, rate_var=v * o.rate**2) if v else o
-                         for v, o in zip(rel_var, observations))
-    obs_set = ObservationSet.from_observations(observations)
-    fit = estimator.fit(obs_set)
-    if checks and uses_static and reference == "angle":  # a wandering axis: the integral is not the rotation
-        observations, obs_set, fit = follow_wander(rec, rec.t if times is None else times, used, observations,
-                                                   obs_set, fit, estimator)
-    quality, warnings, notes, refusal = None, [], [], None
+    req = stages.request(rec, speed, angle, method, noise_std, reference_sd, output_units)
+    reference, value, first_moment = req.reference, req.value, method == "first-moment"
+    seg = stages.windows(rec, reference, value, windows, screen=checks)
+    clock = stages.time_base(rec, read=checks)
+    use = stages.usable(seg, rec, clock, reference, method, refuse_varying=checks and not first_moment)
+    obs = observations(rec, use, reference, value, clock, long_run=long_run and first_moment,
+                        noise_std=noise_std, turn_sd=reference_sd if reference == "angle" else None)
+    obs, obs_set, fit = stages.fit(rec, clock, use.windows, obs, req.estimator,
+                                   wander=checks and first_moment and reference == "angle")
+    checked = stages.Checked(fit)
     if checks:
-        ctx = Context(units=input_units, counts_scale=rec.units == "counts", reference=reference,
-                      declared=value if windows is None or reference == "speed" else math.nan,
-                      sample_rate=rec.sample_rate, has_time=rec.has_time, sensitivity=rec.sensitivity,
-                      counted=tb.counted)
-        scale = input_scale(input_units, rec.sensitivity, out_units)
-        fit, obs_set, quality, warnings, notes = check_fit(fit, obs_set, estimator, [_label(w) for w in used],
-                                                           reference=reference, ctx=ctx, input_scale=scale)
-        refusal = implausible(fit.model.k, ctx)
-        warnings[1 if quality.warnings else 0:0] = list(seg.warnings) + single_turn_warnings(
-            [w.axis for w in used if w.kind == "rotation"], reference, None if windows and reference == "angle" else value)
-        notes += noise_notes(observations, reference, noise_std is not None)
-        if reference_sd:
-            what = ("every turn's angle, {:g} deg" if reference == "angle" else
-                    "the speed, {:g} deg/s, common to every plateau (the three k move together)")
-            notes.append("the 1-sigma includes the declared accuracy of " + what.format(math.degrees(reference_sd)))
-    if reference == "speed" and reference_sd:  # one speed, off on every plateau alike
-        fit = with_common_scale(fit, reference_sd / value)
-    if checks:  # the Earth's rate sits in every reading, and b takes it in
-        fit = with_earth_rate(fit)
+        checked = stages.check(fit, obs_set, obs, req.estimator, rec, use, clock, req,
+                               declared=windows is None or reference == "speed", noise_given=noise_std is not None,
+                               reference_sd=reference_sd)
+    fit = stages.uncertainty(checked.fit, earth_rate=checks,
+                             speed_rel_sd=reference_sd / value if reference == "speed" and reference_sd else None)
+    return result(rec, req, method, use, obs, fit, checked, clock.base, noise_given=noise_std is not None)
+
+
+def observations(rec: Recording, use: stages.Usable, reference: str, value: float, clock: stages.Clock, *,
+                 long_run: bool, noise_std, turn_sd: float | None) -> tuple[Observation, ...]:
+    """Owns reducing each window to an observation: its mean reading and reference rate with variances.
+
+    `long_run`: ripple regressed out and mean variances from the long-run variance (else white);
+    `noise_std`: a floor on the white level; `turn_sd`: each turn's declared angle accuracy [rad].
+    """
+    obs = observe_windows(rec, use.windows, reference, value, long_run=long_run, ripple=long_run,
+                          times=clock.times, period=clock.period)
+    if noise_std is not None:  # the given white level is a floor; the data's long-run correlation still counts
+        obs = white_floor(obs, noise_std)
+    # turns across a time-stamp gap (their rate known within its bound), and each turn's declared accuracy
+    rel_var = reference_variances(use.windows, reference, value, turn_sd, use.angle_var)
+    return tuple(dataclasses.replace(o, rate_var=v * o.rate**2) if v else o for v, o in zip(rel_var, obs))
+
+
+def result(rec: Recording, req: stages.Request, method: str, use: stages.Usable, obs: tuple[Observation, ...],
+           fit: FitResult, checked: stages.Checked, tb: TimeBase | None, *, noise_given: bool) -> CalibrationRun:
+    """Owns the run's result: the calibration in user units with the windows used, and, when checked
+    (`checked.quality` not None), the file's ``fit`` and ``observed`` sections."""
+    input_units = req.input_units
     cal = Calibration(
         model=fit.model,
         input_units=input_units,
-        output_units=out_units,
+        output_units=req.output_units,
         sensitivity=rec.sensitivity if input_units == "counts" else None,
         method=method,
         covariance=fit.covariance,
         noise_std=fit.noise_std,
-        windows=tuple({**w.to_dict(), "rate": o.rate} for w, o in zip(used, observations)),
+        windows=tuple({**w.to_dict(), "rate": o.rate} for w, o in zip(use.windows, obs)),
     )
-    if checks:  # the file's sections, built once (freezing thousands of residuals costs)
+    if checked.quality is not None:  # the file's sections, built once (freezing thousands of residuals costs)
         # every warning and note printed goes in the file too: a flagged calibration must not look clean there
-        cal = dataclasses.replace(cal, fit={**quality.to_document(), "warnings": list(warnings), "notes": list(notes),
-                                            "sigma_covers": sigma_covers(observations, reference, noise_std is not None)},
+        cal = dataclasses.replace(cal, fit={**checked.quality.to_document(), "warnings": list(checked.warnings),
+                                            "notes": list(checked.notes),
+                                            "sigma_covers": sigma_covers(obs, req.reference, noise_given)},
                                   observed=_observed(rec, tb, fit.noise_std, cal.input_scale, input_units))
-    return CalibrationRun(cal, fit, seg, observations, reference, value, quality, tb, tuple(warnings), tuple(notes),
-                          refusal)
+    return CalibrationRun(cal, fit, use.segmentation, obs, req.reference, req.value, checked.quality, tb,
+                          checked.warnings, checked.notes, checked.implausible)
 
 
 def _observed(rec: Recording, tb: TimeBase, noise_std, input_scale: float, input_units: str) -> dict:
@@ -344,8 +326,3 @@ def _spread_blocks(gyro: np.ndarray, sample_rate: float, most: int = 200) -> np.
         return np.array([c[: blocks * size].reshape(blocks, size)[pick].ravel() for c in gyro.T]).T
     return gyro[: blocks * size].reshape(blocks, size, gyro.shape[1])[pick].reshape(-1, gyro.shape[1])
 
-
-def _label(w: Window) -> str:
-    if w.kind == "static":
-        return "static"
-    return w.label or (f"{'+' if w.sign >= 0 else '-'}{w.axis}" if w.axis else "rotation")
