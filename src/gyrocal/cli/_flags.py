@@ -68,6 +68,7 @@ FLAGS: dict[str, str] = {
     "vibration": "--vibration",
     "misalignment_deg": "--misalignment",
     "temps": "--temps",
+    "soak": "--temp-soak",
     "rates": "--rates",
     "step_duration": "--step-duration",
     "temp_noise": "--temp-noise",

@@ -36,11 +36,41 @@ def multi_position(model, gyro_kw, flags: dict, sample_rate, rng, settings):
 
     density = 0.002 if flags["accel_noise_density"] is None else flags["accel_noise_density"]
     at_least("accel_noise_density", density, 0.0, " m/s^2/sqrt(Hz)")
+    if flags["temp_points"] is not None:
+        return _chamber(model, gyro_kw, flags, density * math.sqrt(sample_rate), sample_rate, rng, settings)
+    for name in ("temp_soak", "temp_hysteresis", "temp_noise"):
+        if flags[name] != {"temp_soak": 600.0}.get(name, 0.0):
+            raise InputError(f"--{name.replace('_', '-')} describes a chamber session; add --temp-points T1,T2,..")
     rec, gyro, facts, extra = hand_session(model, gyro_kw=gyro_kw, poses=flags["poses"], tilt_deg=flags["tilt"],
                                            still=flags["still"], accel_noise_std=density * math.sqrt(sample_rate),
                                            misalignment_deg=flags["misalignment"], sample_rate=sample_rate, rng=rng)
     settings.update(extra)
     return rec, gyro, facts
+
+def _chamber(model, gyro_kw, flags: dict, accel_sd: float, sample_rate, rng, settings):
+    """A chamber session (:func:`gyrocal.simulation.chamber.chamber_session`): recording, gyro at 25 degC, facts."""
+    import numpy as np
+
+    from .._validation import at_least, positive
+    from ..models import Affine
+    from ..simulation.chamber import chamber_session, random_thermal_imu
+
+    temps = numbers("--temp-points", flags["temp_points"])
+    positive("static_duration", flags["still"])
+    at_least("temp_soak", flags["temp_soak"], 0.0, " s")
+    at_least("temp_hysteresis", flags["temp_hysteresis"], 0.0, " m/s^2")
+    truth = random_thermal_imu(model, rng, misalignment_deg=flags["misalignment"],
+                               hysteresis=flags["temp_hysteresis"])
+    rec, points = chamber_session(truth, temps, gyro_kw=gyro_kw, poses=flags["poses"], tilt_deg=flags["tilt"],
+                                  still=flags["still"], soak=flags["temp_soak"], accel_noise_std=accel_sd,
+                                  temp_noise=flags["temp_noise"], sample_rate=sample_rate, rng=rng)
+    _, gyro = truth.params(truth.ref_temp)
+    settings.update(poses=flags["poses"], tilt_deg=flags["tilt"], still_s=flags["still"], accel_noise_std=accel_sd,
+                    misalignment_deg=flags["misalignment"], temp_points_degC=temps, temp_soak_s=flags["temp_soak"],
+                    temp_hysteresis_m_s2=flags["temp_hysteresis"], temp_noise_degC=flags["temp_noise"])
+    facts = {"imu_thermal": {**truth.to_dict(), "points": points}}
+    return rec, Affine(K=np.linalg.inv(gyro[:9].reshape(3, 3)), B=gyro[9:]), facts
+
 
 def turntable(gyro_kw, proto, sample_rate, rng, settings):
     """A turntable session of a gyro following the thermal truth: recording, model at 25 degC, facts."""

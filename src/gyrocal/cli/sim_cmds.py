@@ -34,7 +34,9 @@ _PROTOCOL_FLAGS = {
     **dict.fromkeys(("k", "b"), (*_SERVO, "profile", "multi-position")),
     **dict.fromkeys(("poses", "tilt", "still"), ("multi-position",)),
     **dict.fromkeys(("temps", "rates", "step_duration"), ("turntable",)),
-    **dict.fromkeys(("temp_noise", "temp_quantum"), ("turntable", "static")),
+    "temp_noise": ("turntable", "static", "multi-position"),
+    "temp_quantum": ("turntable", "static"),
+    **dict.fromkeys(("temp_points", "temp_soak", "temp_hysteresis"), ("multi-position",)),
     **dict.fromkeys(("profile", "profile_units"), ("profile",)),
     "duration": ("profile", "static"),
     **dict.fromkeys(("temp_start", "temp_end", "warmup_tau", "bias_tempco", "accel_random_walk"), ("static",)),
@@ -84,6 +86,15 @@ def simulate(
         "--tilt", help="--protocol multi-position: tilt between successive poses [deg].")] = 90.0,
     still: Annotated[float, typer.Option(
         "--still", help="--protocol multi-position: still time in each pose [s] (each drawn within +-25 %).")] = 3.0,
+    temp_points: Annotated[Optional[str], typer.Option(
+        "--temp-points", help="--protocol multi-position: a chamber session, a full pose sequence at each of these "
+                              "temperatures [degC], comma-separated, e.g. -25,0,25,50 (default: none, one session "
+                              "at one temperature).")] = None,
+    temp_soak: Annotated[float, typer.Option(
+        "--temp-soak", help="--temp-points: soak before each later point, not recorded (the log jumps) [s].")] = 600.0,
+    temp_hysteresis: Annotated[float, typer.Option(
+        "--temp-hysteresis", help="--temp-points: accelerometer offsets of a point colder than the one before (the "
+                                  "cooling branch) off the heating branch, sign drawn per axis [m/s^2].")] = 0.0,
     profile: Annotated[Optional[Path], typer.Option("--profile", help="--protocol profile: CSV of t,wx,wy,wz (required there).")] = None,
     profile_units: Annotated[str, typer.Option("--profile-units", help="Unit of the profile rates.")] = "rad/s",
     duration: Annotated[Optional[float], typer.Option(
@@ -117,7 +128,8 @@ def simulate(
         "--step-duration", help="--protocol turntable: length of each rate step [s] (default: 60, the paper's).")]
     = None,
     temp_noise: Annotated[float, typer.Option(
-        "--temp-noise", help="--protocol turntable, static: std of each temperature reading [degC].")] = 0.0,
+        "--temp-noise", help="--protocol turntable, static, multi-position with --temp-points: std of each "
+                             "temperature reading [degC].")] = 0.0,
     temp_quantum: Annotated[Optional[float], typer.Option(
         "--temp-quantum", help="--protocol turntable, static: resolution of the temperature readings [degC], e.g. 1 (default: none, not quantised).")]
     = None,
