@@ -29,7 +29,7 @@ def _rate_arg(name: str, text: str | None, default_unit: str) -> float | None:
 _DESIGN_FLAGS = {
     **dict.fromkeys(("speed", "revolutions", "k", "wait", "max_speed"), ("six", "six-static", "twelve")),
     **dict.fromkeys(("poses", "tilt", "still", "peak_rate", "accel_noise_density", "target_cross",
-                     "target_accel_scale", "target_accel_offset"), ("poses",)),
+                     "target_accel_scale", "target_accel_offset", "temp_points", "temp_range"), ("poses",)),
 }
 
 
@@ -77,6 +77,12 @@ def plan(
     target_accel_offset: Annotated[Optional[float], typer.Option(
         "--target-accel-offset", help="--design poses: target std of the accelerometer's offsets [m/s^2] "
         "(default: none).")] = None,
+    temp_points: Annotated[Optional[int], typer.Option(
+        "--temp-points", help="--design poses: a chamber session of this many temperature points over "
+        "--temp-range, the accelerometer's 1-sigma at a point and across the range (default: none, one "
+        "temperature).")] = None,
+    temp_range: Annotated[str, typer.Option(
+        "--temp-range", help="--temp-points: the chamber's range LOW:HIGH [degC].")] = "-25:50",
 ) -> None:
     """Predict each parameter's std and the protocol time; suggest the fastest protocol for a target."""
     import numpy as np
@@ -99,6 +105,15 @@ def plan(
                    "gyro_cross": target_cross, "accel_cross": target_cross, "accel_scale": target_accel_scale,
                    "accel_offset": target_accel_offset}
         density = noise_std(noise, noise_density, sample_rate, 0.0017, allow_zero=False) / math.sqrt(sample_rate)
+        if temp_points is not None:
+            from ._plan_thermal import plan_thermal
+
+            options = dict(static_duration=still, peak_rate_deg=peak_rate, sample_rate=sample_rate,
+                           accel_noise_density=accel_noise_density, gyro_noise_density=float(np.mean(density)))
+            return plan_thermal(temp_points, poses, tilt, temp_range, {k: v for k, v in targets.items()
+                                                                      if v is not None}, options)
+        if temp_range != "-25:50":
+            raise InputError("--temp-range describes a chamber session; add --temp-points N")
         return _plan_poses(poses, tilt, still, peak_rate, sample_rate, accel_noise_density, float(np.mean(density)),
                            {k: v for k, v in targets.items() if v is not None})
 

@@ -1,0 +1,141 @@
+"""``simulate --protocol multi-position --temp-points`` and ``plan --design poses --temp-points``.
+
+References: the truth sidecar's cubics (the simulator's own truth, evaluated here from its JSON), and
+for the plan, the scatter of ``gyrocal imu``'s temperature model over seeded simulated sessions
+(independent of the covariance algebra the plan uses).
+"""
+
+import json
+
+import numpy as np
+import pytest
+from cli_runner import invoke, refused
+
+from gyrocal.files import load
+from gyrocal.imu.planning import predict_poses
+from gyrocal.imu.thermal import calibrate_imu_thermal
+from gyrocal.imu.thermal_planning import predict_thermal, smooth_sigma, suggest_thermal
+from gyrocal.models import ScaleBias
+from gyrocal.simulation.chamber import chamber_session, random_thermal_imu
+
+TEMPS = np.linspace(-25.0, 50.0, 5)
+MID = (TEMPS[1:] + TEMPS[:-1]) / 2
+FS, POSES, STILL, ACCEL_DENSITY = 100.0, 12, 2.0, 2e-3
+_LOWER = np.r_[np.nonzero(np.tril(np.ones((3, 3), bool)).ravel())[0], 9, 10, 11]  # the 9-parameter model's
+
+
+def _truth_params(doc, sensor, temps):
+    """Parameters (N, 12) of `sensor` from the sidecar's cubics at `temps` [degC] (heating branch)."""
+    x = (np.asarray(temps) - doc["ref_temp_degC"]) / doc["scale_degC"]
+    return np.vander(x, 4, increasing=True) @ np.asarray(doc[sensor]["coefs"]).T
+
+
+def _smooth(doc, temps):
+    """Values and 1-sigma (N, m) of a file's smooth model (``accelerometer.thermal.<sensor>``) at `temps`."""
+    sm = doc["smooth"]
+    coefs = np.asarray(sm["coefs"])
+    m, width = coefs.shape
+    powers = np.vander((np.asarray(temps) - sm["centre"]) / sm["scale"], width, increasing=True)
+    cov = np.asarray(sm["covariance"]).reshape(m, width, m, width)
+    return powers @ coefs.T, np.sqrt(np.einsum("np,jpjq,nq->nj", powers, cov, powers))
+
+
+@pytest.fixture(scope="module")
+def chamber_cli(tmp_path_factory):
+    d = tmp_path_factory.mktemp("sim24")
+    log = d / "chamber.csv"
+    code, out, err = invoke("simulate", "--protocol", "multi-position", "--temp-points",
+                            ",".join(f"{t:g}" for t in TEMPS), "--temp-soak", "900", "--temp-noise", "0.05",
+                            "--poses", str(POSES), "--still", str(STILL), "--sample-rate", str(FS), "--noise",
+                            "0.005", "--seed", "4", "-o", log)
+    assert code == 0, err
+    cal = d / "cal.json"
+    code, _, err = invoke("imu", log, "--units", "deg/s", "--accel-units", "m/s^2", "-o", cal)
+    assert code == 0, err
+    return log, json.loads(log.with_suffix(".truth.json").read_text())["imu_thermal"], load(cal).accelerometer
+
+
+def test_the_log_has_a_pose_sequence_per_point_and_jumps_over_each_soak(chamber_cli):
+    log, truth, _ = chamber_cli
+    data = np.genfromtxt(log, delimiter=",", names=True, skip_header=1)
+    points = truth["points"]
+    assert [p["temperature_degC"] for p in points] == TEMPS.tolist()
+    assert all(p["branch"] == "heating" for p in points)
+    for p, q in zip(points[:-1], points[1:]):
+        assert q["samples"][0] == p["samples"][1]
+        assert 900.0 < data["t"][q["samples"][0]] - data["t"][p["samples"][1] - 1] < 901.0
+        np.testing.assert_allclose(np.mean(data["temp"][slice(*p["samples"])]), p["temperature_degC"], atol=0.01)
+    np.testing.assert_allclose(points[2]["accelerometer"], _truth_params(truth, "accelerometer", [TEMPS[2]])[0])
+
+
+def test_imu_recovers_the_sidecars_temperature_model_within_its_sigma(chamber_cli):
+    """Both sensors' smooth models at the points and between them: RMS z of the error against the truth."""
+    _, truth, section = chamber_cli
+    temps = np.r_[TEMPS, MID]
+    z = {}
+    for sensor, keep in (("accelerometer", _LOWER), ("gyro", slice(None))):
+        value, sigma = _smooth(section["thermal"][sensor], temps)
+        z[sensor] = (value - _truth_params(truth, sensor, temps)[:, keep]) / sigma
+    rms = {k: float(np.sqrt(np.mean(v**2))) for k, v in z.items()}
+    print(f"RMS z of the smooth models against the truth: {rms}")
+    # one board, 9 and 12 parameters at 9 temperatures (neighbours correlated): a wide two-sided band
+    assert all(0.4 < v < 1.8 for v in rms.values()), rms
+
+
+def test_hysteresis_moves_the_accelerometer_offsets_of_the_cooling_branch(tmp_path):
+    log = tmp_path / "h.csv"
+    code, _, err = invoke("simulate", "--protocol", "multi-position", "--temp-points", "0,40,0", "--poses", "6",
+                          "--still", "1", "--sample-rate", "50", "--temp-hysteresis", "0.05", "-o", log)
+    assert code == 0, err
+    truth = json.loads(log.with_suffix(".truth.json").read_text())["imu_thermal"]
+    first, _, back = truth["points"]
+    assert (first["branch"], back["branch"]) == ("heating", "cooling")
+    np.testing.assert_allclose(np.subtract(back["accelerometer"], first["accelerometer"])[9:],
+                               truth["hysteresis"]["accel_offset"], atol=1e-12)
+    np.testing.assert_allclose(np.abs(truth["hysteresis"]["accel_offset"]), 0.05)
+
+
+def test_chamber_flags_are_refused_where_they_mean_nothing(tmp_path):
+    assert "--temp-points" in refused("simulate", "--protocol", "multi-position", "--temp-soak", "10",
+                                      "-o", tmp_path / "a.csv")
+    assert "--temp-points" in refused("simulate", "--protocol", "servo", "--temp-points", "0,10",
+                                      "-o", tmp_path / "b.csv")
+    assert "--temp-range" in refused("plan", "--design", "poses", "--temp-points", "5", "--temp-range", "9:1")
+    assert "--target-cross" in refused("plan", "--design", "poses", "--temp-points", "5", "--target-cross", "1e-3")
+
+
+def test_plan_predicts_the_scatter_of_the_temperature_model_over_seeded_sessions():
+    """Reference: 6 seeded boards simulated and fitted by gyrocal imu's thermal calibration; the error of the
+    accelerometer's smooth model between the points over the plan's 1-sigma there (Cramer-Rao per point
+    carried through the weighted polynomial). Orders chosen below the top lower the variance, a missed
+    cubic raises it: the two-sided band holds the ratio of empirical to predicted variance."""
+    plan = predict_poses(POSES, 90.0, static_duration=STILL, sample_rate=FS, accel_noise_density=ACCEL_DENSITY,
+                         gyro_noise_density=np.radians(0.01))
+    predicted = smooth_sigma(TEMPS, np.tile(plan.accel_std, (len(TEMPS), 1)), MID)
+    z = []
+    for seed in range(6):
+        rng = np.random.default_rng(seed)
+        truth = random_thermal_imu(ScaleBias((1.0, 1.0, 1.0), (0.0, 0.0, 0.0)), rng)
+        rec, _ = chamber_session(truth, TEMPS, gyro_kw={"noise_std": np.radians(0.1)}, poses=POSES, still=STILL,
+                                 accel_noise_std=ACCEL_DENSITY * np.sqrt(FS), sample_rate=FS, rng=rng)
+        fit = calibrate_imu_thermal(rec.t, rec.gyro, rec.accel, rec.temp)
+        est, _ = fit.accel.smooth_at(MID)
+        z.append((est - np.array([truth.params(t)[0][_LOWER] for t in MID])) / predicted)
+    ratio = float(np.mean(np.square(z)))
+    print(f"empirical / predicted variance between the points: {ratio:.2f} (6 boards, 9 parameters, 4 temperatures)")
+    assert 0.6 < ratio < 1.6
+
+
+def test_more_points_and_poses_help_and_the_suggestion_is_the_smallest_that_meets_the_target():
+    few, more = predict_thermal(5, 12), predict_thermal(9, 24)
+    assert all(more.between[k] < few.between[k] and more.per_point[k] < few.per_point[k] for k in few.between)
+    assert all(few.between_rms[k] < few.between[k] for k in few.between)
+    target = {"accel_offset": 0.8 * few.between["accel_offset"]}
+    best = suggest_thermal(target)
+    assert best.meets(target) and best.points >= 5
+    assert not any(predict_thermal(n, p).meets(target) for n in range(5, 13) for p in (12, 16, 20, 24, 30, 36, 48)
+                   if n * p < best.points * best.poses)
+    code, out, err = invoke("plan", "--design", "poses", "--temp-points", "5", "--poses", "12",
+                            "--target-accel-offset", str(target["accel_offset"]))
+    assert code == 0, err
+    assert f"{best.points} " in out.split("temperature points")[1].splitlines()[0]
