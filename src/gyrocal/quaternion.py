@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["attitude_change", "attitude_matrices", "from_matrix", "from_rotvec", "multiply", "rotate", "rotvec_matrix",
-           "step_rotvecs", "to_matrix"]
+__all__ = ["align_vectors", "attitude_change", "attitude_matrices", "from_matrix", "from_rotvec", "matrix_rotvec",
+           "multiply", "rotate", "rotvec_matrix", "step_rotvecs", "to_matrix", "to_rotvec"]
 
 
 def multiply(p: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -107,6 +107,37 @@ def from_matrix(r: np.ndarray) -> np.ndarray:
     q = np.choose(k[..., None], [w, x, y, z])
     q /= np.linalg.norm(q, axis=-1, keepdims=True)
     return q * np.where(q[..., :1] < 0, -1.0, 1.0)
+
+
+def to_rotvec(q: np.ndarray) -> np.ndarray:
+    """Rotation vectors (..., 3) [rad], angle in [0, pi], of unit quaternions (..., 4)."""
+    q = np.asarray(q, dtype=float)
+    q = q * np.where(q[..., :1] < 0, -1.0, 1.0)
+    xyz = q[..., 1:]
+    angle = 2.0 * np.arctan2(np.linalg.norm(xyz, axis=-1), q[..., 0])
+    # angle / sin(angle / 2) by its series below 1e-3 rad, as scipy's Rotation.as_rotvec
+    small = angle <= 1e-3
+    a2 = angle * angle
+    scale = np.where(small, 2.0 + a2 / 12.0 + 7.0 * a2 * a2 / 2880.0,
+                     angle / np.sin(0.5 * np.where(small, 1.0, angle)))
+    return scale[..., None] * xyz
+
+
+def matrix_rotvec(r: np.ndarray) -> np.ndarray:
+    """Rotation vectors (..., 3) [rad] of rotation matrices (..., 3, 3); the inverse of :func:`rotvec_matrix`."""
+    return to_rotvec(from_matrix(r))
+
+
+def align_vectors(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Rotation matrix ``R`` (3, 3) that minimises ``sum_i |a_i - R b_i|^2`` over vectors (n, 3) (Wahba's problem).
+
+    Kabsch's solution: ``R = U V^T`` from the SVD of ``sum_i a_i b_i^T``, the last singular direction
+    flipped where that product would be a reflection.
+    """
+    u, _, vh = np.linalg.svd(np.asarray(a, dtype=float).T @ np.asarray(b, dtype=float))
+    if np.linalg.det(u @ vh) < 0:
+        u[:, -1] = -u[:, -1]
+    return u @ vh
 
 
 def _tree_product(m: np.ndarray) -> np.ndarray:

@@ -7,7 +7,7 @@ related by ``w_test = mounting_rotation @ w_ref``. :func:`align` finds both:
 1. coarse offset candidates from the cross-correlation of the rate magnitudes, which do
    not depend on the mounting (:mod:`.coarse`);
 2. for each candidate, the rotation that best maps the reference rate vectors onto the
-   test ones (Wahba's problem, solved by SVD in ``scipy``'s ``Rotation.align_vectors``);
+   test ones (Wahba's problem, solved by SVD: :func:`gyrocal.quaternion.align_vectors`);
    the candidate with the smallest residual wins, which resolves motions whose magnitude
    repeats (the six turns of the servo method of Wang et al. look alike in magnitude);
 3. a drift guess from segment-wise correlation on long logs;
@@ -24,10 +24,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from .._validation import finite_array
 from ..errors import InputError
+from ..quaternion import align_vectors, matrix_rotvec
 from ..units import STANDARD_GRAVITY
 from .coarse import coarse_offsets, grid_rate_for, magnitude_grid, segment_drift
 from .refine import PPM, interpolate, refine
@@ -118,13 +118,13 @@ class Alignment:
     @property
     def rotation_deg(self) -> float:
         """Angle of the mounting rotation [deg]."""
-        return math.degrees(float(np.linalg.norm(Rotation.from_matrix(self.mounting_rotation).as_rotvec())))
+        return math.degrees(float(np.linalg.norm(matrix_rotvec(self.mounting_rotation))))
 
     @property
     def rotation_deg_std(self) -> float:
         """1-sigma of :attr:`rotation_deg` [deg], along the rotation axis (the largest
         small-angle 1-sigma when the rotation is too small to have an axis)."""
-        vec = Rotation.from_matrix(self.mounting_rotation).as_rotvec()
+        vec = matrix_rotvec(self.mounting_rotation)
         cov = self.covariance[2:, 2:]
         norm = float(np.linalg.norm(vec))
         if norm < 1e-9:
@@ -192,8 +192,7 @@ def _candidate_score(t_test, w_test, t_ref, w_ref, offset: float) -> tuple[float
     if inside.sum() < MIN_OVERLAP_SAMPLES:
         return math.inf, None
     v, _, _ = interpolate(t_ref, w_ref, tau[inside])
-    rot, _ = Rotation.align_vectors(w_test[inside], v)
-    r = rot.as_matrix()
+    r = align_vectors(w_test[inside], v)
     dt_test = (t_test[-1] - t_test[0]) / (len(t_test) - 1)
     dt_ref = (t_ref[-1] - t_ref[0]) / (len(t_ref) - 1)
     covered = (t_ref >= t_test[inside][0] - offset) & (t_ref <= t_test[inside][-1] - offset)

@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._signal import correlate, correlation_lags, find_peaks
+
 __all__ = ["CoarseAlignment", "coarse_offsets", "grid_rate_for", "magnitude_grid", "segment_drift"]
 
 #: Highest grid rate of the coarse search [Hz]; the least-squares refinement does the rest.
@@ -83,14 +85,12 @@ def coarse_offsets(t_test, w_test, t_ref, w_ref, rate: float, max_candidates: in
     max_candidates : int
         Most peaks returned; peaks under half the highest are dropped.
     """
-    from scipy import signal
-
     a = _normalised(magnitude_grid(t_test, w_test, rate))
     b = _normalised(magnitude_grid(t_ref, w_ref, rate))
-    rho = signal.correlate(a, b, mode="full", method="fft")
-    lags = signal.correlation_lags(len(a), len(b), mode="full")
+    rho = correlate(a, b, "full")
+    lags = correlation_lags(len(a), len(b))
     top = float(rho.max())
-    found, _ = signal.find_peaks(rho, height=0.5 * top, distance=max(1, int(PEAK_SEPARATION_S * rate)))
+    found = find_peaks(rho, 0.5 * top, max(1, int(PEAK_SEPARATION_S * rate)))
     if len(found) == 0:  # the maximum sits on an end of the lag range
         found = np.array([int(np.argmax(rho))])
     found = found[np.argsort(rho[found])[::-1]][:max_candidates]
@@ -118,8 +118,6 @@ def segment_drift(t_test, w_test, t_ref, w_ref, offset: float, rate: float,
     time [s] and the slope of the local offset against test time [s/s], or None when
     fewer than three segments match (a short log keeps the plain offset).
     """
-    from scipy import signal
-
     a = magnitude_grid(t_test, w_test, rate)
     b = magnitude_grid(t_ref, w_ref, rate)
     seg = max(int(segment_s * rate), len(a) // 50)
@@ -132,7 +130,7 @@ def segment_drift(t_test, w_test, t_ref, w_ref, offset: float, rate: float,
         if j0 < 0 or j0 + seg + 2 * reach > len(b) or not x.any():
             continue
         y = b[j0:j0 + seg + 2 * reach]
-        c = signal.correlate(y, x, mode="valid", method="fft")
+        c = correlate(y, x, "valid")
         rho = c / np.maximum(_window_norms(y, seg) * math.sqrt(float(x @ x)), np.finfo(float).tiny)
         k = int(np.argmax(rho))
         if rho[k] < min_peak:

@@ -33,9 +33,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from ..errors import ConvergenceError
+from ..quaternion import rotvec_matrix
+from ._signal import savgol_slope
 from .bootstrap import optimal_block_length
 
 __all__ = ["Refined", "interpolate", "refine", "smooth_slope"]
@@ -108,12 +109,10 @@ def smooth_slope(t_ref: np.ndarray, w_ref: np.ndarray, width_s: float = SLOPE_WI
     A quadratic is fitted over an odd number of samples (at least 5) on the mean sample
     period, which suits the regular clock of a reference-grade sensor.
     """
-    from scipy.signal import savgol_filter
-
     dt = (t_ref[-1] - t_ref[0]) / (len(t_ref) - 1)
     n = max(5, 2 * round(width_s / dt / 2) + 1)
     n = min(n, len(t_ref) - (1 - len(t_ref) % 2))
-    return savgol_filter(w_ref, n, 2, deriv=1, delta=dt, axis=0, mode="interp")
+    return savgol_slope(w_ref, n, dt)
 
 
 def _chunk(p, sl, a: float, drift: float, rot: np.ndarray, jacobian: bool, exact: bool = False):
@@ -160,7 +159,7 @@ def _solve(h: np.ndarray, g: np.ndarray) -> np.ndarray:
 
 
 def _step(a, drift, rot, delta):
-    return a + delta[0], drift + delta[1], rot @ Rotation.from_rotvec(delta[2:]).as_matrix()
+    return a + delta[0], drift + delta[1], rot @ rotvec_matrix(delta[2:])
 
 
 def _gauss_newton(p, a, drift, rot, fit_drift: bool):
