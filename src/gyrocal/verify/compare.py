@@ -159,7 +159,7 @@ def _joint(diff: np.ndarray, cov_a, cov_b) -> tuple[float, int]:
 
 
 def _compare_vectors(labels, names, units, values, stds, covs, joint: str) -> Comparison:
-    from scipy.stats import chi2 as chi2_dist
+    from .._chi2 import chi2_sf
 
     values, stds = np.asarray(values), np.asarray(stds)
     diff = values[1:] - values[0]
@@ -168,7 +168,7 @@ def _compare_vectors(labels, names, units, values, stds, covs, joint: str) -> Co
     fixed = np.where(diff == 0, 0.0, np.inf)
     z = np.where(np.isnan(combined), np.nan, np.where(combined > 0, diff / np.where(combined > 0, combined, 1.0), fixed))
     chi2, dof = (np.array(x) for x in zip(*(_joint(diff[i], covs[0], covs[i + 1]) for i in range(len(diff)))))
-    p = np.where(np.isnan(chi2) | (dof == 0), np.nan, chi2_dist.sf(np.nan_to_num(chi2), np.maximum(dof, 1)))
+    p = np.array([math.nan if math.isnan(c) or d == 0 else chi2_sf(float(d), float(c)) for c, d in zip(chi2, dof)])
     return Comparison(tuple(labels), tuple(names), tuple(units), values, stds, diff, z, chi2, dof, p, joint)
 
 
