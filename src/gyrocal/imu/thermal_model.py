@@ -8,7 +8,11 @@ weighted by the points' 1-sigma, and the points' covariances carried through tha
 (:func:`gyrocal.thermal.smooth.weighted_coefficients`). Leave-one-out error on a few points is
 itself noisy and its one-standard-error rule leans low, so a parameter whose polynomial misfits the
 points beyond their 1-sigma (chi-square p-value below :data:`MISFIT_P`) is given one order more,
-up to the highest order tried. Points are independent of one another (each
+up to the highest order tried. A parameter kept below the highest order carries that choice's model
+error: the difference ``d`` between its polynomial and the highest order's weighted fit estimates
+the terms it leaves out (its expectation ``bias^2`` plus the variance the extra terms would add), and
+``d d^T`` is added to that parameter's block of the coefficients' covariance (chamber simulations:
+without it the RMS z between the points was 1.3 against 1.0). Points are independent of one another (each
 comes from its own poses), so the Lagrange value's covariance is ``sum_k w_k^2 C_k``.
 """
 
@@ -100,6 +104,19 @@ class TemperatureModel:
         }
 
 
+def _order_error(chosen: SmoothModel, nodes, values, covariances, coefs) -> np.ndarray:
+    """Covariance (m * (P + 1), m * (P + 1)) added for the orders kept below the top ``P``: for each parameter,
+    ``d d^T`` in its own block, ``d`` its coefficients' difference from the top order's weighted fit."""
+    top = coefs.shape[1] - 1
+    full, _, _ = weighted_coefficients(replace(chosen, orders=np.full_like(chosen.orders, top)), nodes, values,
+                                       covariances)
+    d = full - coefs
+    m, width = d.shape
+    out = np.zeros((m, width, m, width))
+    out[np.arange(m), :, np.arange(m), :] = d[:, :, None] * d[:, None, :]
+    return out.reshape(m * width, m * width)
+
+
 def temperature_model(names, nodes, values, covariances, max_order: int = 3) -> TemperatureModel:
     """Build the :class:`TemperatureModel` of parameters `values` (n, m) with `covariances` (n, m, m) at `nodes`."""
     nodes = np.asarray(nodes, dtype=float)
@@ -118,6 +135,7 @@ def temperature_model(names, nodes, values, covariances, max_order: int = 3) -> 
         if not raise_.any():
             break
         chosen = replace(chosen, orders=chosen.orders + raise_)
+    cov = cov + _order_error(chosen, nodes, values, covariances, coefs)
     smooth = SmoothModel(centre=chosen.centre, scale=chosen.scale, orders=chosen.orders, coefs=coefs,
                          loto_rms=chosen.loto_rms)
     return TemperatureModel(names=tuple(names), nodes=nodes, values=values, covariances=covariances, smooth=smooth,
