@@ -34,6 +34,13 @@ def _band(z) -> tuple[float, float]:
     return float(np.sqrt(np.mean(z**2))), 4 / math.sqrt(2 * z.size)
 
 
+def _assert_unit_rms(*groups) -> None:
+    """Each group of z-scores (k's, b's) has RMS 1 within its two-sided band."""
+    for z in groups:
+        rms, tol = _band(z)
+        assert abs(rms - 1) < tol, (rms, tol)
+
+
 def _turns_only(log: R.Log, tmp_path, **kw):
     """Calibrate `log` from a windows file holding only its six turns (declared angles exact)."""
     path = tmp_path / "log.csv"
@@ -65,9 +72,7 @@ def test_six_turns_without_static_windows_behind_the_chips_filter(tmp_path, rate
         a, b = _z(run, log)
         zk.append(a)
         zb.append(b)
-    for z in (zk, zb):
-        rms, tol = _band(z)
-        assert abs(rms - 1) < tol, (rms, tol)
+    _assert_unit_rms(zk, zb)
 
 
 def test_a_given_noise_is_a_floor_not_the_whole_story(tmp_path):
@@ -84,9 +89,7 @@ def test_a_given_noise_is_a_floor_not_the_whole_story(tmp_path):
         a, b = _z(run, log)
         zk.append(a)
         zb.append(b)
-    for z in (zk, zb):
-        rms, tol = _band(z)
-        assert abs(rms - 1) < tol, (rms, tol)
+    _assert_unit_rms(zk, zb)
 
 
 def test_the_bias_carries_the_earths_rate(tmp_path):
@@ -103,6 +106,4 @@ def test_the_bias_carries_the_earths_rate(tmp_path):
         a, b = _z(run, log)
         zk.append(a)
         zb.append(b)
-    for z in (zk, zb):
-        rms, tol = _band(z)
-        assert abs(rms - 1) < tol, (rms, tol)
+    _assert_unit_rms(zk, zb)
