@@ -77,8 +77,8 @@ def stage(name: str, work: Path, step: float) -> dict:
     if name == "imports":  # what every stage loads before it reads a byte: the fixed part of its memory
         import pyarrow.csv  # noqa: F401
 
-        import gyrocal.files  # noqa: F401
         import gyrocal.io  # noqa: F401
+        import gyrocal.results.files  # noqa: F401
         import gyrocal.thermal  # noqa: F401
     elif name == "pyarrow":
         import pyarrow.csv as pcsv
@@ -86,8 +86,8 @@ def stage(name: str, work: Path, step: float) -> dict:
         table = pcsv.read_csv(session, read_options=pcsv.ReadOptions(skip_rows=1))
         pcsv.write_csv(table, out)
     elif name.startswith("apply"):
-        from gyrocal.files import load
         from gyrocal.io import read_recording, recording_columns, write_recording
+        from gyrocal.results.files import load
 
         cal = load(work / "thermal.json")
         rec = read_recording(session, units="deg/s", saturation="ignore")
@@ -115,8 +115,8 @@ def stage(name: str, work: Path, step: float) -> dict:
 
 
 def _prepare(work: Path, step: float) -> int:
-    from gyrocal.files import save
     from gyrocal.io import write_recording
+    from gyrocal.results.files import save
     from gyrocal.simulation.thermal_truth import ThermalTruth
     from gyrocal.simulation.turntable import TurntableProtocol, simulate_turntable
     from gyrocal.thermal import calibrate_thermal

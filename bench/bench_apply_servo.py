@@ -41,7 +41,7 @@ def _pyarrow(log: Path, out: Path, cal: Path) -> None:
     import pyarrow as pa
     import pyarrow.csv as pcsv
 
-    from gyrocal.files import load_calibration
+    from gyrocal.results.files import load_calibration
 
     matrix, offset = load_calibration(cal).correction
     types = pcsv.ConvertOptions(column_types=dict.fromkeys(NAMES, pa.float64()))

@@ -119,13 +119,13 @@ def _check_steps(rec, run, windows, fit) -> None:
     """The steps only the self-checks take, as ``calibrate`` takes them (on the `windows` `run` used): time
     base, gap screening, the wandering-axis pass (angles), goodness of fit with the groups' extra variances and
     their refits, plausibility, the file's sections."""
+    from gyrocal.checks.fit import check_fit
+    from gyrocal.checks.plausibility import Context
+    from gyrocal.checks.screening import screen_gaps
     from gyrocal.estimators import make_estimator
-    from gyrocal.fit_checks import check_fit
+    from gyrocal.observations.turn_angle import follow_wander
     from gyrocal.pipeline import _observed
-    from gyrocal.plausibility import Context
-    from gyrocal.screening import screen_gaps
-    from gyrocal.sections import FitQuality, Observed
-    from gyrocal.turn_angle import follow_wander
+    from gyrocal.results.sections import FitQuality, Observed
 
     tb = rec.time_base()
     screen_gaps(run.segmentation, rec, tb, run.reference, tb.clock_times() if tb.gaps else None)

@@ -25,7 +25,7 @@ import time
 #: What ``import gyrocal.cli`` loaded before the lazy imports: the package root's names and the command
 #: modules' top-level imports.
 PREVIOUS = ("import numpy; import gyrocal.calibration, gyrocal.estimators, gyrocal.models, gyrocal.observations, "
-            "gyrocal.recording, gyrocal.segmentation, gyrocal.units, gyrocal.windows; ")
+            "gyrocal.recording, gyrocal.segmentation, gyrocal.units, gyrocal.segmentation.windows; ")
 RUN = "import gyrocal.cli, sys; sys.argv = ['gyrocal'] + {argv!r}; gyrocal.cli.main()"
 
 

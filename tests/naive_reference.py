@@ -1,6 +1,6 @@
 """Plain re-implementations of the numerical pieces that ``tests/naive_selfcheck.py`` builds on.
 
-Written from the documented behaviour of gyrocal.longrun, gyrocal.timebase and gyrocal.timegaps (their
+Written from the documented behaviour of gyrocal.observations.longrun, gyrocal.recording.timebase and gyrocal.recording.timegaps (their
 docstrings are the specification), not from their code, and sharing no function with them: medians and
 quantiles by sorting, least squares on designs built column by column, a line fit by centred normal
 equations, the periodogram's taper, padding and bins spelled out. They are meant to be obviously right rather than fast
@@ -16,14 +16,14 @@ import math
 import numpy as np
 
 # -- documented constants, restated (an import would follow a mutation of them) --
-BLOCK_STEPS = 64  # gyrocal.timebase._BLOCK: steps per block of the nominal period's median
-ENVELOPE = 50  # gyrocal.timebase._ENVELOPE: samples per block of the lower envelope, at least
-ENVELOPE_S = 0.5  # gyrocal.timebase._ENVELOPE_S [s]: and at least this long
-LATE_EXTRA = 2.0  # gyrocal.timebase._LATE_EXTRA: a late delivery exceeds the packet step by this many periods
-LATE_HOLD = 0.01  # gyrocal.timebase._LATE_HOLD [s]: ... and by this long
-CANDIDATE_STEP = 1.5  # gyrocal.timegaps.CANDIDATE_STEP: shorter steps (in periods) cannot hide a lost sample
-LATE_STEP = 3.0  # gyrocal.timegaps.LATE_STEP: a step this many periods long that lost nothing is late
-MIN_SPAN = 8  # gyrocal.longrun._MIN_SPAN: shortest span of the span-variance fit [samples]
+BLOCK_STEPS = 64  # gyrocal.recording.timebase._BLOCK: steps per block of the nominal period's median
+ENVELOPE = 50  # gyrocal.recording.timebase._ENVELOPE: samples per block of the lower envelope, at least
+ENVELOPE_S = 0.5  # gyrocal.recording.timebase._ENVELOPE_S [s]: and at least this long
+LATE_EXTRA = 2.0  # gyrocal.recording.timebase._LATE_EXTRA: a late delivery exceeds the packet step by this many periods
+LATE_HOLD = 0.01  # gyrocal.recording.timebase._LATE_HOLD [s]: ... and by this long
+CANDIDATE_STEP = 1.5  # gyrocal.recording.timegaps.CANDIDATE_STEP: shorter steps (in periods) cannot hide a lost sample
+LATE_STEP = 3.0  # gyrocal.recording.timegaps.LATE_STEP: a step this many periods long that lost nothing is late
+MIN_SPAN = 8  # gyrocal.observations.longrun._MIN_SPAN: shortest span of the span-variance fit [samples]
 
 
 def median(values) -> float:

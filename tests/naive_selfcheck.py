@@ -2,7 +2,7 @@
 
 Each function here reduces the way gyrocal did before the speed work (window by window, full-rate passes,
 one whole-recording array after another), on the plain re-implementations of ``tests/naive_reference.py``:
-nothing here calls gyrocal.longrun, gyrocal.timebase or gyrocal.timegaps (their TimeBase and Gap are only
+nothing here calls gyrocal.observations.longrun, gyrocal.recording.timebase or gyrocal.recording.timegaps (their TimeBase and Gap are only
 the containers :func:`analyse_time` fills for :func:`install`), so a slip in any of them shows as a
 difference. ``tests/test_fast_paths.py`` compares the fast paths with them on seeded data (equal to
 rounding), and ``bench/bench_selfcheck.py`` times them as its naive baseline in the same process.
@@ -23,7 +23,7 @@ import numpy as np
 from gyrocal._validation import finite_array, positive
 from gyrocal.errors import InputError
 from gyrocal.observations import Observation
-from gyrocal.partial_cycles import partial_cycles, weigh_readings
+from gyrocal.observations.partial_cycles import partial_cycles, weigh_readings
 
 
 def _time_weights(t: np.ndarray, n: int) -> np.ndarray:
@@ -63,7 +63,7 @@ def observe(samples, sample_rate, kind, *, speed=None, angle=None, t=None, level
 
 
 def observe_windows(rec, windows, reference, speed, *, long_run=True, ripple=True, times=None):
-    """Every window reduced on its own (gyrocal.window_stats.observe_windows as it was)."""
+    """Every window reduced on its own (gyrocal.observations.window_stats.observe_windows as it was)."""
     times = rec.t if times is None else times
     stats = {}
     if long_run or ripple:
@@ -83,7 +83,7 @@ def observe_windows(rec, windows, reference, speed, *, long_run=True, ripple=Tru
 
 
 def newey_west_var(x, lags=None, *, prewhiten=True):
-    """Long-run variance of the mean, column by column of an (n, k) array (gyrocal.longrun as it was)."""
+    """Long-run variance of the mean, column by column of an (n, k) array (gyrocal.observations.longrun as it was)."""
     x = np.asarray(x, dtype=float)
     n = len(x)
     d = x - x.mean(axis=0)
@@ -103,7 +103,7 @@ def newey_west_var(x, lags=None, *, prewhiten=True):
 
 
 def fit_level(x, t, lines):
-    """One plateau's regression on its own design matrix (gyrocal.longrun as it was)."""
+    """One plateau's regression on its own design matrix (gyrocal.observations.longrun as it was)."""
     if not lines:
         level = x.mean(axis=0)
         return level, 1.0 / len(x), x - level
@@ -121,7 +121,7 @@ def _pooled_lrv(residuals):
 
 
 def window_stats(rec, windows, reference, times, *, long_run, ripple):
-    """Plateau levels and long-run variances, plateau by plateau (gyrocal.window_stats as it was)."""
+    """Plateau levels and long-run variances, plateau by plateau (gyrocal.observations.window_stats as it was)."""
     d = max(1, int(round(rec.sample_rate / 200.0)))
     gyro = ref.block_means(rec.gyro, d)
     clock = ref.block_means(np.asarray(times, dtype=float), d)
@@ -195,7 +195,7 @@ def _find_gaps(r: np.ndarray, step: np.ndarray, period: float, floor: np.ndarray
 
 
 def time_facts(t, *, has_time: bool = True) -> dict:
-    """The facts of gyrocal.timebase.TimeBase for stamps `t`, as a dict (gaps as ``(index, step, lost)``)."""
+    """The facts of gyrocal.recording.timebase.TimeBase for stamps `t`, as a dict (gaps as ``(index, step, lost)``)."""
     t = np.asarray(t, dtype=float)
     if t.ndim != 1 or len(t) < 2:
         raise InputError(f"a time base needs at least two sample times, got shape {t.shape}")
@@ -246,8 +246,8 @@ def analyse_time(t, *, has_time: bool = True, breaks=()):
     """:func:`time_facts` in the library's container (for :func:`install`: the pipeline reads a TimeBase).
 
     The reference reads contiguous logs only: the breaks the recording found are passed through."""
-    from gyrocal.timebase import TimeBase
-    from gyrocal.timegaps import Gap
+    from gyrocal.recording.timebase import TimeBase
+    from gyrocal.recording.timegaps import Gap
 
     facts = time_facts(t, has_time=has_time)
     return TimeBase(**{**facts, "gaps": tuple(Gap(*g) for g in facts["gaps"]), "breaks": tuple(breaks)})
@@ -256,12 +256,12 @@ def analyse_time(t, *, has_time: bool = True, breaks=()):
 # -- the calibration's other pieces as they were --
 
 def _spread_blocks(gyro: np.ndarray, sample_rate: float, most: int = 200) -> np.ndarray:
-    """Up to `most` whole blocks of half a second (:data:`gyrocal.observed.QUIET_BLOCK`), evenly spread over `gyro`.
+    """Up to `most` whole blocks of half a second (:data:`gyrocal.observations.observed.QUIET_BLOCK`), evenly spread over `gyro`.
 
     The quiet-noise level is a pooled standard deviation of quiet blocks: two hundred of them
     give it to a fraction of a per cent, for a fraction of the work on a long log.
     """
-    size = max(8, int(round(0.5 * sample_rate)))  # gyrocal.observed.QUIET_BLOCK = 0.5 s
+    size = max(8, int(round(0.5 * sample_rate)))  # gyrocal.observations.observed.QUIET_BLOCK = 0.5 s
     blocks = len(gyro) // size
     if blocks <= most:
         return gyro
@@ -301,10 +301,10 @@ def pipeline_windows(rec, windows, reference, speed, *, long_run=True, ripple=Tr
 def _patches() -> list[tuple[object, str, object]]:
     import gyrocal.pipeline
     import gyrocal.recording
-    import gyrocal.sections
+    import gyrocal.results.sections
 
     return [(gyrocal.recording, "analyse_time", analyse_time), (gyrocal.pipeline, "observe_windows", pipeline_windows),
-            (gyrocal.pipeline, "_spread_blocks", _spread_blocks), (gyrocal.sections, "_freeze", _freeze)]
+            (gyrocal.pipeline, "_spread_blocks", _spread_blocks), (gyrocal.results.sections, "_freeze", _freeze)]
 
 
 def install(monkeypatch) -> None:

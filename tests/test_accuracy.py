@@ -12,9 +12,9 @@ import math
 import numpy as np
 import pytest
 
-from gyrocal.design import Design, crb_covariance
 from gyrocal.estimators import algorithm1_batch, first_moment_batch, paper_lm_batch
 from gyrocal.models import ScaleBias
+from gyrocal.planning.design import Design, crb_covariance
 from gyrocal.simulation.windows import paper_observations
 
 N = 2000

@@ -8,10 +8,10 @@ import math
 import numpy as np
 import pytest
 
-from gyrocal.calibration import Calibration
 from gyrocal.errors import FileFormatError
-from gyrocal.files import from_document, load_calibration, save_calibration
 from gyrocal.models import Affine, ScaleBias
+from gyrocal.results.calibration import Calibration
+from gyrocal.results.files import from_document, load_calibration, save_calibration
 
 
 def scale_bias_cal(rng) -> Calibration:

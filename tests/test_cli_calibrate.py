@@ -331,8 +331,8 @@ def test_example_uncertainty_matches_monte_carlo_within_20_percent(tmp_path):
 @pytest.fixture
 def thermal_file(tmp_path):
     """A thermal table whose bias grows 0.01 deg/s per degC, with a 1 % x scale error."""
-    from gyrocal.files import save_thermal
     from gyrocal.models import Affine
+    from gyrocal.results.files import save_thermal
     from gyrocal.thermal import ThermalCalibration, fit_smooth
 
     temps = np.array([-10.0, 10.0, 30.0, 50.0])

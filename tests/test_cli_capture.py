@@ -240,7 +240,7 @@ def test_capture_warns_when_the_device_result_is_off(tmp_path, servo):
 
 def imu_z_scores(cal_path: Path, s) -> np.ndarray:
     """(calibration file - simulator truth) / the file's own 1-sigma: accelerometer (9) and gyro (12) parameters."""
-    from gyrocal.files import load_calibration
+    from gyrocal.results.files import load_calibration
 
     cal = load_calibration(cal_path)
     part = cal.accelerometer["parameters"]

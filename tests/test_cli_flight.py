@@ -14,8 +14,8 @@ from cli_runner import invoke, refused  # noqa: E402
 from dataflash_writer import imu_log  # noqa: E402
 from firmware_models import ardupilot_correct, parse_ardupilot, parse_px4, px4_offsets  # noqa: E402
 
-from gyrocal.files import load
 from gyrocal.noise import NoiseReport
+from gyrocal.results.files import load
 
 
 @pytest.fixture(scope="module")
@@ -215,7 +215,7 @@ def test_thermal_bias_from_a_dataflash_log(tmp_path, rng):
 def test_turntable_file_exports_its_bias_with_a_warning(tmp_path):
     from test_firmware_params import _turntable
 
-    from gyrocal.files import save
+    from gyrocal.results.files import save
 
     thermal = tmp_path / "thermal.json"
     save(_turntable(), thermal)

@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 from cli_runner import invoke, refused
 
-from gyrocal.files import load_calibration
 from gyrocal.io import write_csv
 from gyrocal.models import ScaleBias
-from gyrocal.observed import check_observed, observe, quiet_noise
+from gyrocal.observations.observed import check_observed, observe, quiet_noise
+from gyrocal.results.files import load_calibration
 from gyrocal.simulation import VirtualGyro
 from gyrocal.simulation.servo import ServoProtocol, simulate_servo
 
@@ -341,8 +341,8 @@ def test_segments_plot_marks_ignored_turns_and_nothing_covers_the_data(session, 
 
 def test_simulate_rates_with_their_units_and_counts_with_a_sensitivity(tmp_path):
     """Reference: the truth sidecar, which stores SI; 2 deg/s of noise is 0.0349 rad/s."""
-    from gyrocal.files import load
     from gyrocal.io import read_recording
+    from gyrocal.results.files import load
     from gyrocal.simulation.truth import SimulationTruth
 
     code, _, err = invoke("simulate", "-o", tmp_path / "a.csv", "--noise", "2deg/s", "--b", "0.5,0.1,0.2deg/s",

@@ -58,7 +58,7 @@ def test_calibrate_prints_fit_quality_and_writes_the_sections(bursty_csv, tmp_pa
     assert doc["fit"]["dof"] == 21 and len(doc["fit"]["residuals"]) == 13
     assert doc["observed"]["time_base"]["median_step"] < 0.006 < doc["observed"]["time_base"]["mean_step"]
     assert doc["observed"]["units"] == "deg/s" and len(doc["observed"]["max_abs_rate"]) == 3
-    from gyrocal.files import load
+    from gyrocal.results.files import load
 
     assert load(out_file).fit["dof"] == 21  # the file loads back with its sections
 

@@ -15,7 +15,7 @@ from cli_runner import invoke, refused  # noqa: E402
 
 from gyrocal import load_calibration  # noqa: E402
 from gyrocal.io import read_recording  # noqa: E402
-from gyrocal.noise_file import load_noise  # noqa: E402
+from gyrocal.noise.document import load_noise  # noqa: E402
 
 
 def test_simulated_recording_travels_the_calibration_path(tmp_path):

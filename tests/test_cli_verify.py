@@ -16,8 +16,8 @@ from cli_runner import invoke, refused
 from verify_pairs import make_pair
 
 from gyrocal import Calibration, ScaleBias
-from gyrocal.files import load, save
 from gyrocal.io import write_recording
+from gyrocal.results.files import load, save
 from gyrocal.simulation import VirtualGyro, simulate_profile
 from gyrocal.simulation.reference import simulate_reference
 from gyrocal.simulation.thermal_truth import ThermalTruth

@@ -5,7 +5,11 @@ import math
 import numpy as np
 import pytest
 
-from gyrocal.design import (
+from gyrocal.errors import DegenerateDesignError, InputError
+from gyrocal.estimators import first_moment_batch
+from gyrocal.models import ScaleBias
+from gyrocal.observations import ObservationSet
+from gyrocal.planning.design import (
     Design,
     Rotation,
     Static,
@@ -19,10 +23,6 @@ from gyrocal.design import (
     predicted_covariance,
     predicted_std,
 )
-from gyrocal.errors import DegenerateDesignError, InputError
-from gyrocal.estimators import first_moment_batch
-from gyrocal.models import ScaleBias
-from gyrocal.observations import ObservationSet
 from gyrocal.simulation.windows import paper_observations
 
 SPEED = math.pi / 3

@@ -20,7 +20,7 @@ HISTORY = re.compile(r"\bbefore:|\bused to\b|\bpreviously\b|\bno longer\b|\bform
 #: (file, the line's text around the phrase): a use of a phrase that is no history, and why.
 ALLOWED = {
     ("segmentation/_measure.py", "Used to show people what was there"): "'is used to': what the measures are for",
-    ("sections.py", "used to catch unit mistakes later"): "'is used to': what the section is for",
+    ("results/sections.py", "used to catch unit mistakes later"): "'is used to': what the section is for",
     ("studies/servo_convergence.py", "per case used to count iterations"): "'are used to': what the runs are for",
     ("capture/device.py", "the device no longer holds it"): "the simulated port's state while it runs",
 }

@@ -5,7 +5,6 @@ import math
 import numpy as np
 import pytest
 
-from gyrocal.design import Design, crb_covariance
 from gyrocal.errors import ConvergenceError, DegenerateDesignError, NonFiniteInputError, NonPhysicalEstimateError
 from gyrocal.estimators import (
     Algorithm1,
@@ -20,6 +19,7 @@ from gyrocal.estimators._checks import require_positive_k2
 from gyrocal.estimators.paper_model import gamma, regressors
 from gyrocal.models import ScaleBias
 from gyrocal.observations import ObservationSet
+from gyrocal.planning.design import Design, crb_covariance
 from gyrocal.simulation.windows import PAPER_AXES, paper_observations
 
 SPEED = math.pi / 3  # 60 deg/s, the servo method of Wang et al., section III-A

@@ -15,7 +15,7 @@ import yaml
 from gyrocal import Calibration, ScaleBias, save_calibration
 from gyrocal.errors import FileFormatError, InputError
 from gyrocal.export import EXPORT_FORMATS, export_file, exporter, register_exporter, render
-from gyrocal.files import load
+from gyrocal.results.files import load
 
 
 @pytest.fixture

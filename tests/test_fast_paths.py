@@ -3,7 +3,7 @@
 Reference: ``tests/naive_selfcheck.py`` (window by window, whole-log arrays, candidate gaps judged one by
 one) on ``tests/naive_reference.py`` (plain code written from the documented behaviour: medians and
 quantiles by sorting, least squares on designs built column by column, a line by centred sums). Neither calls a
-function of gyrocal.longrun, gyrocal.timebase or gyrocal.timegaps, so a slip in any of them shows here;
+function of gyrocal.observations.longrun, gyrocal.recording.timebase or gyrocal.recording.timegaps, so a slip in any of them shows here;
 run on the same seeded data. Tolerances: sums taken in another order differ by a few units in the last
 place, relative 1e-15 per sum, so window reductions are held to 1e-12; the time base's decisions (gaps,
 lost samples, late deliveries, a regular clock) must be identical, and its times (a difference, median,
@@ -22,16 +22,16 @@ import naive_selfcheck as naive
 import numpy as np
 import pytest
 
-from gyrocal.longrun import block_means, find_lines, fit_level, fit_levels, newey_west_var, span_variance
 from gyrocal.models import ScaleBias
-from gyrocal.moments import window_moments
 from gyrocal.observations import observe
+from gyrocal.observations.longrun import block_means, find_lines, fit_level, fit_levels, newey_west_var, span_variance
+from gyrocal.observations.moments import window_moments
 from gyrocal.pipeline import _spread_blocks, calibrate
-from gyrocal.sections import FitQuality
+from gyrocal.recording.timebase import analyse_time
+from gyrocal.results.sections import FitQuality
 from gyrocal.simulation import VirtualGyro
 from gyrocal.simulation.servo import PAPER_TURNS, ServoProtocol, simulate_servo
 from gyrocal.simulation.timestamps import ReceiveClock, with_time_defects
-from gyrocal.timebase import analyse_time
 
 RECEIVE = ReceiveClock(read_time=0.0003, jitter=0.0002)
 

@@ -10,10 +10,10 @@ from typing import ClassVar
 import numpy as np
 import pytest
 
-from gyrocal.calibration import Calibration
 from gyrocal.errors import FileFormatError, InputError
-from gyrocal.files import KINDS, kinds, load, register, save
 from gyrocal.models import Affine, ScaleBias
+from gyrocal.results.calibration import Calibration
+from gyrocal.results.files import KINDS, kinds, load, register, save
 from gyrocal.simulation.truth import SimulationTruth, truth_path
 from gyrocal.thermal import ThermalCalibration
 

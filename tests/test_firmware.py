@@ -22,12 +22,12 @@ import pytest
 
 import gyrocal
 from gyrocal import firmware
-from gyrocal.calibration import Calibration
 from gyrocal.capture.agreement import C_ROUND, EPS32, accumulator_bound, solution_bound
 from gyrocal.errors import DegenerateDesignError, InputError, NonPhysicalEstimateError, OutOfRangeError
 from gyrocal.estimators import Algorithm1, FirstMoment
 from gyrocal.models import KG_INDEX, Affine, ScaleBias
 from gyrocal.observations import ObservationSet, observe
+from gyrocal.results.calibration import Calibration
 from gyrocal.simulation.windows import paper_observations
 from gyrocal.thermal import ThermalCalibration, ThermalRangeWarning, fit_smooth, interpolate, lagrange_weights
 from gyrocal.units import unit_factor

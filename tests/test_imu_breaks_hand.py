@@ -12,12 +12,12 @@ the true times); the defects are added here, independently of gyrocal's detector
 import numpy as np
 import pytest
 
-from gyrocal.breaks import spans_break
 from gyrocal.imu import calibrate_imu
 from gyrocal.imu.gyro import PairCheck, _beyond_noise
 from gyrocal.imu.run import calibrate_recording
 from gyrocal.io import read_recording
 from gyrocal.models import Affine
+from gyrocal.recording.breaks import spans_break
 from gyrocal.simulation.gyro import VirtualGyro
 from gyrocal.simulation.multiposition import MultiPositionProtocol, VirtualImu, simulate_multi_position
 
@@ -160,9 +160,9 @@ def test_the_threshold_override_is_used_and_said(tmp_path):
 
 
 def test_calibrate_leaves_out_turns_across_a_break_and_cuts_static_windows():
-    from gyrocal.screening import screen_breaks
+    from gyrocal.checks.screening import screen_breaks
     from gyrocal.segmentation import Segmentation
-    from gyrocal.windows import Window
+    from gyrocal.segmentation.windows import Window
 
     seg = Segmentation(windows=(Window(0, 100, "static"), Window(100, 200, "rotation", "z", 1), Window(200, 300, "static")))
     out = screen_breaks(seg, [150, 250])

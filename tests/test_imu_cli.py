@@ -12,8 +12,8 @@ import pytest
 from cli_runner import invoke, refused
 
 from gyrocal import firmware
-from gyrocal.files import load
 from gyrocal.io import read_recording
+from gyrocal.results.files import load
 
 
 @pytest.fixture(scope="module")

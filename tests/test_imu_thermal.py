@@ -111,9 +111,9 @@ def test_too_few_temperature_points_is_one_line_error():
 
 def test_a_chamber_recording_writes_the_thermal_section_and_old_files_still_load(tmp_path):
     """calibrate_recording finds the breaks and plateaus itself; the file holds the points and both models."""
-    from gyrocal.calibration import Calibration
     from gyrocal.imu.run import calibrate_recording
     from gyrocal.recording import Recording
+    from gyrocal.results.calibration import Calibration
 
     truth, _, t, gyro, accel, temp, _ = _chamber(7, poses=12)
     rec = Recording(t=t, gyro=gyro, accel=accel, accel_units="m/s^2", accel_source_units="m/s^2",
@@ -134,9 +134,9 @@ def test_a_chamber_recording_writes_the_thermal_section_and_old_files_still_load
 
 def test_apply_corrects_both_sensors_at_each_samples_temperature():
     """Reference: the generator's truth at 30 degC, between the points; apply with the file beats the point at 20."""
-    from gyrocal.calibration import Calibration
     from gyrocal.imu.run import calibrate_recording
     from gyrocal.recording import Recording
+    from gyrocal.results.calibration import Calibration
 
     truth, _, t, gyro, accel, temp, _ = _chamber(8, poses=12)
     rec = Recording(t=t, gyro=gyro, accel=accel, accel_units="m/s^2", accel_source_units="m/s^2",

@@ -13,10 +13,10 @@ from cli_runner import invoke, refused
 from imu_chamber import TEMPS, Truth, chamber
 
 from gyrocal import firmware
-from gyrocal.files import load
 from gyrocal.imu.accel import model_matrices
 from gyrocal.imu.poses import fibonacci_directions
 from gyrocal.io import read_recording, write_csv
+from gyrocal.results.files import load
 
 BETWEEN_T = 30.0
 

@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 from cli_runner import invoke, refused
 
-from gyrocal.files import load
 from gyrocal.imu.planning import predict_poses
 from gyrocal.imu.thermal import calibrate_imu_thermal
 from gyrocal.imu.thermal_planning import predict_thermal, smooth_sigma, suggest_thermal
 from gyrocal.models import ScaleBias
+from gyrocal.results.files import load
 from gyrocal.simulation.chamber import chamber_session, random_thermal_imu
 
 TEMPS = np.linspace(-25.0, 50.0, 5)

@@ -16,7 +16,7 @@ import pandas as pd
 import pytest
 
 from gyrocal.cli.app import run
-from gyrocal.files import load_calibration
+from gyrocal.results.files import load_calibration
 
 DATA = Path(str(resources.files("gyrocal") / "data" / "imucal_ferraris"))
 SESSION = DATA / "example_ferraris_session.csv"

@@ -10,12 +10,12 @@ import pyarrow.parquet as pq
 import pytest
 from cli_runner import invoke, refused
 
-from gyrocal.calibration import Calibration
 from gyrocal.errors import InputError, UnitError
-from gyrocal.files import save
 from gyrocal.io import read_recording, write_recording
 from gyrocal.models import ScaleBias
 from gyrocal.recording import Recording
+from gyrocal.results.calibration import Calibration
+from gyrocal.results.files import save
 
 G0 = 9.80665
 

@@ -10,7 +10,7 @@ import pytest
 
 from gyrocal.errors import FileFormatError
 from gyrocal.io import read_windows
-from gyrocal.windows import Window
+from gyrocal.segmentation.windows import Window
 
 # imucal's layout, written the way imucal writes it (a synthetic session, not its data)
 IMUCAL = {

@@ -17,26 +17,37 @@ import gyrocal
 
 SRC = Path(gyrocal.__file__).parent
 
-#: Component -> components it must never import (a component is a top-level module or subpackage of gyrocal).
-_FRONT = {"io", "cli", "plotting", "simulation", "studies", "export", "exporters", "thermal_report"}
-FORBIDDEN: dict[str, set[str]] = {
-    **{core: _FRONT | {"files", "firmware"}
-       for core in ("models", "observations", "estimators", "design", "segmentation", "windows", "recording",
-                    "units", "saturation", "planning", "noise", "stillness", "flight", "imu")},
-    # ThermalCalibration is a calibration kind: it registers with gyrocal.files and has c_header (firmware)
-    "thermal": _FRONT,
-    "simulation": {"io", "cli", "plotting", "studies", "thermal", "firmware", "export", "exporters"},
-    "plotting": {"cli", "io", "studies"},
-    "io": {"cli", "plotting", "simulation", "studies", "thermal"},
-    "studies": {"cli"},
-    # the calibration store keeps results; it computes nothing and knows no file format or front end
-    "store": _FRONT | {"files", "firmware", "thermal", "calibration", "pipeline"},
+#: The stages a recording passes through, bottom to top (docs/architecture.md): a package imports packages of
+#: its own rank or below, never above. Rank 0 is the package root's shared vocabulary (errors, units,
+#: constants, choices, models, quaternion and the private helpers).
+RANKS: dict[str, int] = {
+    "recording": 1,                        # samples, units and the time base
+    "segmentation": 2,                     # windows: turns, standstills, stillness
+    "io": 3, "observations": 3,            # reading files; windows reduced to observations
+    "estimators": 4,                       # the fits
+    "checks": 5, "planning": 5,            # self-checks of a fit; predicted accuracy of a design
+    "results": 6,                          # the calibration, its sections, the file registry
+    "pipeline": 7, "imu": 7, "thermal": 7, "flight": 7, "noise": 7, "verify": 7,   # the methods (jobs' cores)
+    "jobs": 8, "firmware": 8, "export": 8, "simulation": 8, "plotting": 8, "store": 8,
+    "studies": 9, "capture": 9, "station": 9,
+    "cli": 10, "__main__": 11,
 }
-#: Components that never use the store (it is for front ends and batch jobs, not for the numerics).
-for _core in ("models", "observations", "estimators", "design", "segmentation", "windows", "recording", "units",
-              "saturation", "planning", "noise", "stillness", "flight", "imu", "thermal", "simulation", "io",
-              "plotting"):
-    FORBIDDEN[_core] = FORBIDDEN.get(_core, set()) | {"store"}
+#: Imports against the ranks, inside one function each, with the reason they are allowed.
+UPWARD: dict[tuple[str, str], str] = {
+    ("gyrocal.results.calibration", "gyrocal.imu.thermal"): "Calibration.apply corrects an IMU thermal section",
+    ("gyrocal.results.calibration", "gyrocal.firmware.header"): "Calibration.c_header, a public method",
+    ("gyrocal.thermal.model", "gyrocal.firmware.header"): "ThermalCalibration.c_header, a public method",
+    ("gyrocal.results.files", "gyrocal.thermal.model"): "load_thermal / load_correction name the kind they return",
+    ("gyrocal.results.legacy", "gyrocal.thermal.model"): "the v1 thermal upgrade applies the model's rule",
+}
+#: Packages that, within the ranks, must still not import these (same rank or below).
+FORBIDDEN: dict[str, set[str]] = {
+    "simulation": {"io", "thermal", "plotting", "export", "firmware", "store", "jobs"},
+    "plotting": {"store", "jobs", "firmware"},
+    "export": {"store", "jobs"},
+}
+#: Packages that import nothing of gyrocal but the package root's vocabulary.
+ROOT_ONLY = {"store"}
 #: Modules of gyrocal.cli that hold commands; each may import none of the others.
 CMDS_SUFFIX = "_cmds"
 #: Module-level imports a command module may make: ``gyrocal --help`` must not load numpy.
@@ -90,6 +101,21 @@ def _owner(module: str) -> str:
     return module
 
 
+def _rank_allows(mine: str, theirs: str, me: str, target: str, top: bool) -> bool:
+    """May package `mine` import `target` of package `theirs`? By rank, with the listed exceptions."""
+    if mine in ROOT_ONLY and theirs in RANKS:
+        return False
+    if theirs in FORBIDDEN.get(mine, ()):
+        return False
+    if theirs not in RANKS:  # the root's vocabulary: anyone may import it
+        return True
+    if mine not in RANKS:  # a root module importing a stage package
+        return me in ("gyrocal", "gyrocal.__main__") or any(me == a and target.startswith(b) for a, b in UPWARD)
+    if RANKS[theirs] <= RANKS[mine]:
+        return True
+    return not top and any(me == a and (target == b or target.startswith(b + ".")) for a, b in UPWARD)
+
+
 SOURCES = sorted(p for p in SRC.rglob("*.py"))
 
 
@@ -106,8 +132,10 @@ def _problems() -> list[str]:
                         "numpy", "scipy", "rich", "matplotlib", "pyarrow"):
                     found.append(f"{where}: command module imports {target} at module level (lazy imports only)")
                 continue
-            if theirs in FORBIDDEN.get(mine, ()):
-                found.append(f"{where}: {mine} must not import {target}")
+            if theirs is not None and mine is not None and theirs != mine:
+                if not _rank_allows(mine, theirs, me, target, top):
+                    found.append(f"{where}: {mine} (rank {RANKS.get(mine)}) must not import {target} "
+                                 f"(rank {RANKS.get(theirs)})")
             if theirs == "cli" and mine not in ("cli", "__main__"):
                 found.append(f"{where}: the library must not import the command line ({target})")
             if target == "gyrocal" and name is not None and me != "gyrocal":
@@ -137,7 +165,10 @@ def test_no_forbidden_import():
 
 
 @pytest.mark.parametrize("bad, message", [
-    ("from ..io import read_recording\n", "thermal must not import gyrocal.io"),
+    ("from ..simulation import simulate\n", "thermal (rank 7) must not import gyrocal.simulation (rank 8)"),
+    ("from ..results.calibration import Calibration\nfrom ..firmware.header import calibration_header\n",
+     "must not import gyrocal.firmware.header"),
+    ("from ..store import open_store\n", "thermal (rank 7) must not import gyrocal.store"),
     ("from ..models import _KG_ROWS\n", "gyrocal.models._KG_ROWS is private"),
     ("from ..segmentation._motion import static_level\n", "gyrocal.segmentation._motion is private"),
     ("from ..cli import app\n", "must not import the command line"),
@@ -248,3 +279,28 @@ def test_the_cycle_check_finds_one():
     """A ring of three modules is found, and a module outside it is not."""
     graph = {"gyrocal.a": {"gyrocal.b"}, "gyrocal.b": {"gyrocal.c"}, "gyrocal.c": {"gyrocal.a"}, "gyrocal.d": {"gyrocal.a"}}
     assert _cycles(graph) == [["gyrocal.a", "gyrocal.b", "gyrocal.c"]]
+
+
+def test_no_cycle_between_packages():
+    """Reference: the import statements (ast). Packages of one rank may import each other, but never in a ring;
+    the listed exceptions of UPWARD are left out, as they are the only imports against the ranks."""
+    graph: dict[str, set[str]] = {}
+    for module, targets in _import_graph(SOURCES).items():
+        mine = _component(module)
+        for target in targets:
+            theirs = _component(target)
+            if mine and theirs and mine != theirs and not any(module == a and target.startswith(b) for a, b in UPWARD):
+                graph.setdefault(f"gyrocal.{mine}", set()).add(f"gyrocal.{theirs}")
+    for name in list(graph):
+        for child in graph[name]:
+            graph.setdefault(child, set())
+    assert _cycles(graph) == []
+
+
+def test_every_stage_package_has_a_rank_and_says_what_it_owns():
+    """Every subpackage is placed in RANKS, and its docstring names its layer as RANKS does."""
+    inits = sorted(SRC.glob("*/__init__.py"))
+    assert [p.parent.name for p in inits if p.parent.name not in RANKS] == []
+    wrong = [p.parent.name for p in inits
+             if f"Layer {RANKS[p.parent.name]} (" not in (ast.get_docstring(ast.parse(p.read_text())) or "")]
+    assert wrong == []

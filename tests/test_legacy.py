@@ -12,12 +12,12 @@ import pytest
 from approx import assert_close_tree
 from cli_runner import invoke
 
-from gyrocal.calibration import Calibration
 from gyrocal.errors import FileFormatError
-from gyrocal.files import load, to_document
 from gyrocal.io import read_recording
-from gyrocal.legacy import upgrade
 from gyrocal.models import KG_NAMES
+from gyrocal.results.calibration import Calibration
+from gyrocal.results.files import load, to_document
+from gyrocal.results.legacy import upgrade
 from gyrocal.thermal import ThermalCalibration
 
 DATA = Path(__file__).parent / "data"

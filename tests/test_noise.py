@@ -16,7 +16,7 @@ import pytest
 from gyrocal.errors import FileFormatError, InputError, UnitError
 from gyrocal.models import ScaleBias
 from gyrocal.noise import NoiseWarning, characterise, characterise_recording
-from gyrocal.noise_file import load_noise, noise_density_arg, save_noise
+from gyrocal.noise.document import load_noise, noise_density_arg, save_noise
 from gyrocal.recording import Recording
 from gyrocal.simulation import VirtualGyro
 

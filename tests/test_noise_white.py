@@ -18,7 +18,7 @@ import yaml
 
 from gyrocal.flight import imu_utils_yaml
 from gyrocal.noise import NoiseWarning, characterise
-from gyrocal.noise_file import load_noise, save_noise
+from gyrocal.noise.document import load_noise, save_noise
 
 FS, SIGMA = 200.0, 0.01
 TRUTH = SIGMA / math.sqrt(FS)

@@ -8,7 +8,9 @@ from scipy.optimize import brentq
 from scipy.stats import chi2, multivariate_normal, norm
 from scipy.stats import t as student_t
 
-from gyrocal import excess, units
+from gyrocal import units
+from gyrocal.checks import excess
+from gyrocal.checks.screening import screen_gaps
 from gyrocal.estimators import FirstMoment
 from gyrocal.flight.polyfit import choose_orders
 from gyrocal.models import ScaleBias
@@ -16,12 +18,11 @@ from gyrocal.noise.figures import read_figures
 from gyrocal.observations import ObservationSet
 from gyrocal.pipeline import calibrate
 from gyrocal.recording import Recording
-from gyrocal.screening import screen_gaps
 from gyrocal.segmentation import Segmentation
+from gyrocal.segmentation.windows import Window
 from gyrocal.simulation import VirtualGyro
 from gyrocal.simulation.servo import ServoProtocol, simulate_servo
 from gyrocal.verify.whitenoise import second_difference_noise
-from gyrocal.windows import Window
 
 
 def test_mad_to_sigma_is_gaussian_consistency():
@@ -40,7 +41,7 @@ def test_one_standard_error_rule_picks_lower_order():
     assert int(choose_orders(cv, k)[0]) == 2
 
 
-# --- the extra variances of gyrocal.excess: Student's t factor, the solved tau^2, the evidence threshold ---
+# --- the extra variances of gyrocal.checks.excess: Student's t factor, the solved tau^2, the evidence threshold ---
 
 
 @pytest.mark.parametrize("dof", [6.5, 9.0, 30.0])
@@ -84,7 +85,7 @@ def test_a_group_is_widened_only_below_p_one_tenth(side, flagged):
 def test_flagged_paper_fit_has_covariance_times_chi2_per_dof():
     """Reference: Birge's scaling, covariance x chi2/dof with chi2 summed here from the reported residuals;
     the unchecked fit (checks off) of the same recording gives the covariance before scaling."""
-    from gyrocal.noise_terms import EARTH_RATE
+    from gyrocal.checks.noise_terms import EARTH_RATE
 
     gyro = VirtualGyro(ScaleBias(np.array([1.0069, 0.9960, 0.9955]), np.array([0.0442, -0.0089, 0.0076])),
                        noise_std=0.01)
@@ -102,7 +103,7 @@ def test_flagged_paper_fit_has_covariance_times_chi2_per_dof():
         np.testing.assert_allclose(run.fit.covariance, plain.fit.covariance * chi2_per_dof + earth, rtol=1e-8)
 
 
-# --- the gap bound of gyrocal.screening ---
+# --- the gap bound of gyrocal.checks.screening ---
 
 
 def test_hidden_gap_of_known_bound_gives_the_uniform_variance():
@@ -203,7 +204,7 @@ def test_measured_mean_variances_give_the_gls_covariance():
 def test_a_fit_is_flagged_below_p_one_in_a_thousand(p, flagged):
     """Reference: chi2.isf from scipy: twenty one-row windows whose chi2 for 14 dof (6 parameters) has p-value `p`;
     the paper's methods (no groups) are flagged, and their covariance scaled, below p = 1e-3."""
-    from gyrocal.quality import assess_fit
+    from gyrocal.checks.quality import assess_fit
 
     total = chi2.isf(p, 20 - 6)
     residuals = [np.array([math.sqrt(total / 20)])] * 20
@@ -218,7 +219,7 @@ def test_a_step_between_neighbouring_blocks_is_judged_against_sqrt2_sigma(a, mov
     Samples alternate +-1 (each 1 s block: mean 0, spread 1, so a mean's sigma is 1 / sqrt(100) = 0.1 exactly);
     two neighbouring blocks move by +a and -a: |dev| = a stays under 8 sigma, and their step 2a is judged against
     8 sqrt(2) x 0.1 = 1.13 (0.96: still, 1.2: a motion)."""
-    from gyrocal.stillness import find_motion
+    from gyrocal.segmentation.stillness import find_motion
 
     x = np.tile(np.where(np.arange(100) % 2, -1.0, 1.0), 200)[:, None] * np.ones(3)
     x[5000:5100] += a
@@ -258,7 +259,7 @@ def test_a_temperature_point_has_the_ols_standard_errors_with_n_minus_4_dof():
 def test_quiet_noise_pools_unbiased_block_variances():
     """Reference: the unbiased sample variance worked by hand: blocks of 8 samples alternating +1, -1 have
     sum of squares 8 over 8 - 1 degrees of freedom, so the pooled noise is sqrt(8 / 7)."""
-    from gyrocal.observed import quiet_noise
+    from gyrocal.observations.observed import quiet_noise
 
     x = np.tile([1.0, -1.0], 4 * 20)[:, None] * np.ones(3)  # 20 blocks of 8 at 16 Hz (half-second blocks)
     np.testing.assert_allclose(quiet_noise(x, 16.0), math.sqrt(8 / 7), rtol=1e-12)

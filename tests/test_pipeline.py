@@ -11,13 +11,13 @@ import numpy as np
 import pytest
 
 from gyrocal.errors import InputError, SegmentationError
-from gyrocal.files import load_calibration, save_calibration
 from gyrocal.models import ScaleBias
 from gyrocal.pipeline import CalibrationRun, calibrate
 from gyrocal.recording import Recording
+from gyrocal.results.files import load_calibration, save_calibration
+from gyrocal.segmentation.windows import Window
 from gyrocal.simulation import VirtualGyro
 from gyrocal.simulation.servo import PAPER_TURNS, ServoProtocol, simulate_servo
-from gyrocal.windows import Window
 
 K = np.array([1.0069, 0.9960, 0.9955])  # the servo method of Wang et al., Table III (MPU9250)
 B = np.array([0.0442, -0.0089, 0.0076])  # [rad/s]
@@ -171,7 +171,7 @@ def test_known_noise_sets_the_white_level(rng):
     """A given noise is a floor on every window's noise (issue 22): above the data's own it sets the covariance
     (twice the noise, twice the 1-sigma; b's less the Earth's rate it also carries); far below it the data's
     long-run variance still counts, and the 1-sigma stays what the data give."""
-    from gyrocal.noise_terms import EARTH_RATE
+    from gyrocal.checks.noise_terms import EARTH_RATE
 
     rec, _ = simulate_servo(GYRO, PROTOCOLS["paper"], sample_rate=FS, rng=rng)
     a = calibrate(rec, speed=SPEED, noise_std=0.1)

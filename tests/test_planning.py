@@ -9,9 +9,9 @@ import math
 import numpy as np
 import pytest
 
-from gyrocal.design import Design, predicted_std
 from gyrocal.errors import InputError
 from gyrocal.planning import build_design, predict, suggest
+from gyrocal.planning.design import Design, predicted_std
 
 DENSITY = 0.035 / math.sqrt(200.0)
 

@@ -12,7 +12,7 @@ from matplotlib.figure import Figure
 from gyrocal import Calibration, Recording, ScaleBias
 from gyrocal.plotting import new_figure, save_figure
 from gyrocal.plotting.calibration import calibration_figure, plot_corrected, plot_windows
-from gyrocal.windows import Window
+from gyrocal.segmentation.windows import Window
 
 FS = 100.0
 SPEED = math.radians(60.0)

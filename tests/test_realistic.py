@@ -19,7 +19,7 @@ import realistic as R
 
 from gyrocal.io import read_recording
 from gyrocal.pipeline import calibrate
-from gyrocal.windows import Window
+from gyrocal.segmentation.windows import Window
 
 
 def _rms(z) -> float:

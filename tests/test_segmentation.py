@@ -166,7 +166,7 @@ def test_bad_arguments_are_refused(rng):
 
 
 def test_segmentation_sorts_its_windows():
-    from gyrocal.windows import Window
+    from gyrocal.segmentation.windows import Window
 
     seg = Segmentation((Window(50, 60, "static"), Window(0, 10, "rotation", "x", 1)))
     assert [w.start for w in seg.windows] == [0, 50]

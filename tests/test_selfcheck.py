@@ -14,10 +14,10 @@ import re
 import numpy as np
 import pytest
 
+from gyrocal.checks.quality import GoodnessOfFit
 from gyrocal.errors import InputError, SegmentationError
 from gyrocal.models import ScaleBias
 from gyrocal.pipeline import calibrate
-from gyrocal.quality import GoodnessOfFit
 from gyrocal.recording import Recording
 from gyrocal.segmentation import segment
 from gyrocal.simulation import VirtualGyro
@@ -279,7 +279,7 @@ def test_fit_quality_round_trips_through_its_document(rng):
 def test_each_extra_variance_makes_its_groups_chi2_equal_its_dof():
     """Reference: the defining equation ``sum r2 / (v + c tau2) = dof``, solved here in closed form for equal
     rows: four turns of chi2 4 each at 1.74 dof need tau2 = 16 / 1.74 - 1 (the former bracket stopped at 4)."""
-    from gyrocal.excess import _solve_tau2
+    from gyrocal.checks.excess import _solve_tau2
 
     r2, v, c = np.full(4, 4.0), np.ones(4), np.ones(4)
     assert _solve_tau2(r2, v, c, 1.74) == pytest.approx(16 / 1.74 - 1, rel=1e-9)

@@ -161,7 +161,7 @@ def test_results_with_a_unit_still_load_and_export(inputs, tmp_path):
     assert invoke("thermal-report", files["thermal"], inputs["thermal"], "-o", tmp_path / "report", "--settle", "1",
                   "--no-figures")[0] == 0
     assert invoke("export", files["thermal-bias"], "--format", "ardupilot", "-o", tmp_path / "tc.parm")[0] == 0
-    from gyrocal.noise_file import load_noise
+    from gyrocal.noise.document import load_noise
 
     assert load_noise(files["noise"]).sample_rate == 50.0
 

@@ -6,7 +6,7 @@ running median follows any monotone drift exactly.
 
 import numpy as np
 
-from gyrocal.stillness import find_motion
+from gyrocal.segmentation.stillness import find_motion
 
 
 def test_warm_up_drift_is_not_motion(rng):

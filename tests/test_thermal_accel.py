@@ -15,8 +15,8 @@ from cli_runner import invoke, refused  # noqa: E402
 from dataflash_writer import imu_log  # noqa: E402
 from firmware_models import ardupilot_correct, parse_ardupilot, parse_px4, px4_offsets  # noqa: E402
 
-from gyrocal.files import load
 from gyrocal.flight import ThermalBiasWarning, ardupilot_params, fit_thermal_bias, px4_params
+from gyrocal.results.files import load
 
 FS = 50.0
 T0 = 25.0

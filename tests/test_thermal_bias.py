@@ -11,10 +11,10 @@ import pytest
 
 from gyrocal.errors import FileFormatError, InputError
 from gyrocal.flight import fit_thermal_bias, temperature_course
+from gyrocal.flight.thermal_bias_document import load_thermal_bias, save_thermal_bias
 from gyrocal.models import ScaleBias
 from gyrocal.simulation import VirtualGyro
 from gyrocal.simulation.still import BiasDrift, StillProtocol, simulate_still
-from gyrocal.thermal_bias_file import load_thermal_bias, save_thermal_bias
 
 FS = 100.0
 #: Truth: a cubic on x, a line on y, a parabola on z [rad/s/degC^n] about 25 degC.

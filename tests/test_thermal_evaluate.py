@@ -9,11 +9,11 @@ import dataclasses
 import numpy as np
 import pytest
 
+from gyrocal.plotting.thermal_report import markdown_table, write_report
 from gyrocal.simulation.thermal_truth import ThermalTruth
 from gyrocal.simulation.turntable import TurntableProtocol, simulate_turntable
 from gyrocal.thermal import calibrate_thermal
 from gyrocal.thermal.evaluate import METHODS, evaluate, loto_comparison
-from gyrocal.thermal_report import markdown_table, write_report
 
 NOISE = np.radians(0.05)
 PROTO = {"step_duration": 3.0}

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from gyrocal.errors import FileFormatError, InputError, OutOfRangeError
-from gyrocal.files import load_thermal, save_thermal
 from gyrocal.models import correct, kg_to_kb
 from gyrocal.recording import Recording
+from gyrocal.results.files import load_thermal, save_thermal
 from gyrocal.simulation.thermal_truth import ThermalTruth
 from gyrocal.thermal import (
     ThermalCalibration,

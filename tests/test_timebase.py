@@ -7,8 +7,8 @@ import pytest
 
 from gyrocal.errors import InputError
 from gyrocal.recording import Recording
+from gyrocal.recording.timebase import analyse_time, nominal_period
 from gyrocal.simulation.timestamps import ReceiveClock, drop_samples, receive_times, with_time_defects
-from gyrocal.timebase import analyse_time, nominal_period
 
 FS = 100.0
 BURSTY = ReceiveClock(packet=2, read_time=0.0035, jitter=0.003)  # steps ~2-5 ms and ~15-18 ms

@@ -25,8 +25,11 @@ from __future__ import annotations
 import argparse
 import sys
 
+#: Stage packages whose __init__ itself holds code (a module named like the package is the package).
+_PACKAGES = {"gyrocal.recording", "gyrocal.observations", "gyrocal.planning", "gyrocal.export", "gyrocal.segmentation",
+             "gyrocal.estimators", "gyrocal.io"}
 #: The modules that sequence the run: what they call is the flow.
-TOP = {"gyrocal.pipeline", "gyrocal.stages"}
+TOP = {"gyrocal.pipeline", "gyrocal.pipeline.stages"}
 
 
 def _trace(fn):
@@ -73,6 +76,20 @@ def _trace(fn):
     return entered, calls, returns, depth[0], flow, by_stage
 
 
+def _packages(flow: list[str]) -> list[str]:
+    """The flow by stage package (``gyrocal.checks.quality`` -> ``checks``), repeats in a row collapsed; the package
+    root's vocabulary (units, models) is no stage and is left out."""
+    out: list[str] = []
+    for module in flow:
+        parts = module.split(".")
+        if len(parts) == 2 and module not in _PACKAGES:
+            continue
+        package = parts[1]
+        if not out or out[-1] != package:
+            out.append(package)
+    return out
+
+
 def main(argv=None) -> int:
     """Print the counts for each method on the bundled example."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -97,6 +114,10 @@ def main(argv=None) -> int:
         print(f"{method}: calibrate enters {len(set(flow))} module(s) besides {', '.join(sorted(TOP & entered))} "
               f"and climbs back {again} time(s) ({len(flow)} hand-offs); whole trace: {len(entered)} modules, "
               f"{len(returns)} distinct returns across modules ({sum(returns.values())} in all), depth {depth}")
+        stages = _packages(flow)
+        back = sum(p in stages[:i] for i, p in enumerate(stages))
+        print(f"  by stage package: {' > '.join(stages)} ({len(set(stages))} packages, {len(stages) - 1} hand-offs, "
+              f"{back} climb(s) back to a package already left)")
         if args.list:
             print("  " + " > ".join(m.removeprefix("gyrocal.") for m in flow))
             for name, modules in by_stage.items():

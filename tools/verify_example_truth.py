@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gyrocal.files import load
+from gyrocal.results.files import load
 from gyrocal.units import unit_factor
 
 

@@ -9,7 +9,10 @@ from __future__ import annotations
 
 import importlib
 
+from ._moved import install as _install_moved
 from ._version import __version__
+
+_install_moved()
 
 #: Public name -> module that defines it.
 _EXPORTS = {
@@ -26,12 +29,12 @@ _EXPORTS = {
     "BatchFit": "estimators",
     "make_estimator": "estimators",
     "Recording": "recording",
-    "Calibration": "calibration",
+    "Calibration": "results.calibration",
     "ThermalCalibration": "thermal",
-    "load": "files",
-    "save": "files",
-    "save_calibration": "files",
-    "load_calibration": "files",
+    "load": "results.files",
+    "save": "results.files",
+    "save_calibration": "results.files",
+    "load_calibration": "results.files",
     "read_recording": "io",
 }
 

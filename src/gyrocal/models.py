@@ -12,7 +12,7 @@ and keeps each paper's own parameters, converting exactly in both directions:
 
 Models are unit-agnostic numbers: ``o`` is in the units of the readings and ``A``
 maps reading units to output units. The package keeps both in rad/s inside; files
-record units explicitly (see :mod:`gyrocal.calibration`).
+record units explicitly (see :mod:`gyrocal.results.calibration`).
 """
 
 from __future__ import annotations

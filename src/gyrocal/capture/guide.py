@@ -26,7 +26,7 @@ from typing import Literal
 from ..errors import InputError
 from ..recording import Recording
 from ..segmentation import segment
-from ..windows import Window
+from ..segmentation.windows import Window
 
 __all__ = ["GUIDES", "Guide", "GuideEvent", "Step", "SteppedJudge"]
 

@@ -32,7 +32,7 @@ from ..imu.planning import DETECTOR_WINDOW
 from ..imu.poses import DISTINCT_DEG, UP, coverage, pose_sequence
 from ..imu.statics import detect_statics
 from ..recording import Recording
-from ..windows import Window
+from ..segmentation.windows import Window
 from .guide import GuideEvent, SteppedJudge
 
 __all__ = ["CANDIDATES", "HOLD_S", "MIN_POSES", "MIN_SPREAD", "PoseGuide", "describe", "guided_directions",

@@ -17,9 +17,9 @@ import numpy as np
 from .._validation import positive
 from ..models import ScaleBias
 from ..recording import Recording
+from ..segmentation.windows import Window
 from ..simulation import ServoProtocol, VirtualGyro, simulate_servo
 from ..units import STANDARD_GRAVITY
-from ..windows import Window
 
 __all__ = ["MPU6050_ACCEL_SENSITIVITY", "MPU6050_SENSITIVITY", "DeviceSession", "counts", "simulate_device_session"]
 

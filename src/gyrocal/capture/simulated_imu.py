@@ -19,6 +19,7 @@ from .. import quaternion as quat
 from .._validation import positive
 from ..imu.poses import UP
 from ..models import ScaleBias
+from ..segmentation.windows import Window
 from ..simulation import VirtualGyro
 from ..simulation.multiposition import (
     MultiPositionProtocol,
@@ -28,7 +29,6 @@ from ..simulation.multiposition import (
     simulate_multi_position,
 )
 from ..units import STANDARD_GRAVITY
-from ..windows import Window
 from .simulated import MPU6050_ACCEL_SENSITIVITY, MPU6050_SENSITIVITY, DeviceSession, _temperature, counts
 
 __all__ = ["orientation_up", "simulate_device_imu_session", "z_scores"]

@@ -3,6 +3,8 @@
 Each command group lives in its own module (``*_cmds``); they never import each other,
 and shared pieces live in the ``_*`` helper modules. :data:`HELP_ORDER` is the one
 place that sets the order of ``gyrocal --help``.
+
+Layer 10 (the command line) of docs/architecture.md: imports the package root and layers 1 to 10 only.
 """
 
 from __future__ import annotations

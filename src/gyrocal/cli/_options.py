@@ -69,7 +69,7 @@ def noise_std(noise: float | None, density: str | None, sample_rate: float, defa
     """Per-sample white noise (3,) [rad/s] from --noise or --noise-density (> 0 unless `allow_zero`)."""
     import numpy as np
 
-    from ..noise_file import noise_density_arg
+    from ..noise.document import noise_density_arg
 
     if noise is not None and density is not None:
         raise InputError("give --noise or --noise-density, not both")

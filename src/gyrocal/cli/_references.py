@@ -69,7 +69,7 @@ def noise_to_internal(text: str | None, units: str, rate_unit: str, sensitivity:
 
 def density_to_internal(noise_density: str, noise_std: float | None, rec):
     """--noise-density (rad/s/sqrt(Hz), per axis) as per-sample noise [rad/s] at the recording's rate."""
-    from ..noise_file import noise_density_arg
+    from ..noise.document import noise_density_arg
 
     if noise_std is not None:
         raise InputError("give --noise-std or --noise-density, not both")

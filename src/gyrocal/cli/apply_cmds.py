@@ -68,7 +68,7 @@ def apply(
         raise InputError("give the calibration file and the recording (or --store URL --unit SERIAL and the "
                          "recording)")
     else:
-        from ..files import load_correction
+        from ..results.files import load_correction
 
         refuse_swapped(calibration, recording, command="apply", usage="calibration file comes")
         cal = load_correction(calibration)
@@ -109,7 +109,7 @@ def apply(
 
 def _check_observed(cal, rec, source: str, name: str) -> None:
     """Warn of data unlike the calibration's (read in its input unit: the rates times a scale, not a copy)."""
-    from ..observed import check_observed
+    from ..observations.observed import check_observed
 
     scale = 1.0 / cal.input_scale if rec.units == "rad/s" else 1.0
     note = check_observed(cal.observed, rec.gyro, rec.sample_rate, source=source, calibration=name,
@@ -122,8 +122,8 @@ def _from_store(url: str, serial: str | None, recording: Path, at: str | None):
     """The unit's calibration in force at the recording's time, and a name for it (a path of the store)."""
     from datetime import datetime, timezone
 
-    from ..calibration import Calibration
-    from ..files import from_document
+    from ..results.calibration import Calibration
+    from ..results.files import from_document
     from ..station.identity import check_serial
     from ..store import open_store
     from ..thermal.model import ThermalCalibration

@@ -166,8 +166,8 @@ def _print_checks(run) -> None:
 
 def _truth_calibration(path: Path, cal):
     """The example's true model in the units of `cal`, from its truth sidecar."""
-    from ..calibration import Calibration
-    from ..files import load
+    from ..results.calibration import Calibration
+    from ..results.files import load
     from ..simulation.truth import SimulationTruth
 
     truth = load(path, SimulationTruth)
@@ -250,7 +250,7 @@ def calibrate(
     check_output(plot, flag="--plot", inputs=inputs + (output,), outputs=(output,), force=True)
     # files first: a reader that closes stdout early (| head) must not cost the outputs
     if plot is not None:
-        from ..windows import Window
+        from ..segmentation.windows import Window
 
         windows_used = [Window.from_dict(d) for d in cal.windows]
         _save_plot(plot, rec, windows_used, cal, speed_rad, f"{Path(recording).name}: {reference} reference")

@@ -62,8 +62,8 @@ def _implausible(tb, rec, log: Path, fs: float) -> str | None:
     """The plausibility rule on a still log whose unit was declared (a flight log's unit is its format's)."""
     import numpy as np
 
+    from ..checks.plausibility import still_units
     from ..io.flightlog import flight_log_kind
-    from ..plausibility import still_units
 
     if log.is_file() and flight_log_kind(log) is not None or rec.source_units not in ("deg/s", "rad/s"):
         return None
@@ -100,8 +100,8 @@ def thermal_bias(
 ) -> None:
     """Fit gyro bias (and accelerometer offset change) against temperature for PX4 and ArduPilot (then
     'gyrocal export --format px4' or ardupilot)."""
-    from ..files import to_document
     from ..flight import ThermalBias, fit_thermal_bias
+    from ..results.files import to_document
 
     check_output(output, inputs=(log,), force=force, replaceable=json_format(ThermalBias.FORMAT))
     accel = {"accel_units": accel_units, "accel_sensitivity": accel_sensitivity, "gravity": gravity}

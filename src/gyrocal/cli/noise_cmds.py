@@ -103,8 +103,8 @@ def noise(
     flags: StationFlags = StationFlags(),
 ) -> None:
     """Allan deviation of a log at rest: noise density, bias instability and random walk, with intervals."""
-    from ..files import to_document
     from ..noise import FORMAT, characterise_recording
+    from ..results.files import to_document
     from ..units import parse_rate_unit, unit_factor
 
     # every output is checked before anything is read, computed or written

@@ -191,9 +191,9 @@ def simulate(
     session) with its truth sidecar."""
     import numpy as np
 
-    from ..files import save
     from ..io import write_recording
     from ..models import ScaleBias
+    from ..results.files import save
     from ..simulation.truth import SimulationTruth
     from ..units import parse_rate_unit
 

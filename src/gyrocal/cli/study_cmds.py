@@ -75,7 +75,7 @@ def study(
     if noise_density is not None:
         import numpy as np
 
-        from ..noise_file import noise_density_arg
+        from ..noise.document import noise_density_arg
 
         sd = float(np.mean(noise_density_arg(noise_density))) * math.sqrt(sample_rate)
         if settings is None:

@@ -118,7 +118,7 @@ def _implausible(cal) -> str | None:
     """The plausibility rule on the table's scale factors (1 / Kxx.. at the temperature where they are worst)."""
     import numpy as np
 
-    from ..plausibility import far_scale
+    from ..checks.plausibility import far_scale
 
     k = 1.0 / np.abs(cal.kg[:, :3])  # K maps the table's rate to the reading; the scale factor is its inverse
     worst = int(np.argmax(np.max(np.abs(np.log(k)), axis=1)))
@@ -166,7 +166,7 @@ def _load_table(path: Path, load_thermal):
     try:
         return load_thermal(path)
     except FileFormatError:
-        from ..files import load_correction
+        from ..results.files import load_correction
 
         try:
             other = load_correction(path)
@@ -200,9 +200,9 @@ def thermal_report(
     figures: Annotated[bool, typer.Option("--figures/--no-figures", help="Draw the PNG figures.")] = True,
 ) -> None:
     """Compare uncompensated, traditional, Lagrange and smooth compensation on a test recording."""
-    from ..files import load_thermal
+    from ..plotting.thermal_report import write_report
+    from ..results.files import load_thermal
     from ..thermal.evaluate import evaluate
-    from ..thermal_report import write_report
 
     refuse_swapped(calibration, test, command="thermal-report", usage="thermal file from 'gyrocal thermal' comes")
     check_output(output, inputs=(calibration, test), folder=True)

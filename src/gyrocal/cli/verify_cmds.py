@@ -108,7 +108,7 @@ def _write_outputs(folder: Path, report, series, stretch, figures: bool) -> list
     import contextlib
 
     from .._atomic import atomic_path, write_text_atomic
-    from ..files import save
+    from ..results.files import save
     from ..verify.summary import summary_markdown
 
     writers = {"verify.json": lambda path: save(report, path),
@@ -188,7 +188,7 @@ def verify(
                           "MPU9250, repeating its turns) and its reference log (deg/s, 100 Hz, own clock).")] = False,
 ) -> None:
     """Check a calibration against a reference gyro that recorded the same motion (two clocks, two mounts)."""
-    from ..files import load_correction
+    from ..results.files import load_correction
     from ..verify import verify_calibration
 
     if example:
@@ -250,7 +250,7 @@ def compare(
         min=0.0)] = None,
 ) -> None:
     """Compare calibrations of one unit (power cycles, days, rigs) in units of their combined 1-sigma."""
-    from ..files import load
+    from ..results.files import load
     from ..verify.compare import compare_calibrations
 
     if len(files) < 2:

@@ -2,6 +2,8 @@
 
 Each estimator holds only its configuration; ``fit`` returns a frozen
 :class:`FitResult` and ``fit_batch`` a :class:`BatchFit` over many gyros.
+
+Layer 4 (the fits) of docs/architecture.md: imports the package root and layers 1 to 4 only.
 """
 
 from ._checks import require_count, require_full_rank

@@ -1,4 +1,4 @@
-"""Each window's residual against a fitted model, in noise units (for :func:`gyrocal.quality.assess_fit`).
+"""Each window's residual against a fitted model, in noise units (for :func:`gyrocal.checks.quality.assess_fit`).
 
 * first moment: a rotation window's ``|diag(k)(m_mean + b)| - rate``, and a static window's
   ``diag(k)(m_mean + b)`` (three values), each divided by its standard deviation from the

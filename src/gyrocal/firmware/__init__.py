@@ -4,6 +4,9 @@
   (``Calibration.c_header``, ``ThermalCalibration.c_header``);
 * :mod:`.host`: the library built with the host's C compiler and called through ctypes,
   to check it against Python.
+
+Layer 8 (firmware, exports, simulation, figures and the store) of docs/architecture.md: imports the package
+root and layers 1 to 8 only.
 """
 
 from .header import C_LIBRARY_VERSION, calibration_header, thermal_header

@@ -88,7 +88,7 @@ def calibration_header(cal, *, prefix: str = "gyrocal") -> str:
 
     Parameters
     ----------
-    cal : gyrocal.calibration.Calibration
+    cal : gyrocal.results.calibration.Calibration
         A scale-bias or affine calibration.
     prefix : str
         Start of every identifier defined (upper-cased), a C identifier.

@@ -8,8 +8,10 @@
 * :func:`kalibr_yaml`, :func:`vins_yaml`, :func:`imu_utils_yaml`: noise files from a
   :class:`~gyrocal.noise.NoiseReport`.
 
-The thermal-bias file is :mod:`gyrocal.thermal_bias_file`; the exporters are registered by
-:mod:`gyrocal.flight_exporters`.
+The thermal-bias file is :mod:`gyrocal.flight.thermal_bias_document`; the exporters are registered by
+:mod:`gyrocal.export.flight`.
+
+Layer 7 (the methods) of docs/architecture.md: imports the package root and layers 1 to 7 only.
 """
 
 from .firmware_params import ardupilot_params, px4_params

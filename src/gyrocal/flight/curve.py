@@ -20,8 +20,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._validation import finite_array
+from .._white import robust_difference_std
 from ..errors import InputError
-from ..units import MAD_TO_SIGMA
 from .polyfit import ar1_covariance, choose_orders, segment_cv, vander
 
 __all__ = ["AccelDrift", "BlockGrid", "SensorFit", "TemperaturePolynomial", "check_curve", "fit_sensor"]
@@ -171,7 +171,7 @@ def fit_sensor(x: np.ndarray, grid: BlockGrid, max_order: int, *, label: str = "
     orders = choose_orders(cv[: max_order + 1], len(np.unique(grid.seg)))
     size = grid.size
     d = np.diff(x[: len(x) // size * size].reshape(-1, size, 3), axis=1).reshape(-1, 3)
-    noise = MAD_TO_SIGMA * np.median(np.abs(d - np.median(d, axis=0)), axis=0) / math.sqrt(2.0)  # white, robust to drift
+    noise = robust_difference_std(d)  # white, robust to drift
     coefs, cov, resid_rms, wander = _fit_axes(grid.u, means, orders, noise**2 / size, grid.half)
     if relative:
         coefs[:, 0] = 0.0

@@ -5,7 +5,7 @@ This is what the flight stacks calibrate: PX4 (``process_sensor_caldata.py``) an
 output of a board that is cooled, then powered and left still while it warms. gyrocal
 fits the same kind of polynomial, but
 
-* refuses a log that moves (:mod:`gyrocal.stillness`) or spans too few degrees (10 degC by
+* refuses a log that moves (:mod:`gyrocal.segmentation.stillness`) or spans too few degrees (10 degC by
   default, ArduPilot's minimum: ``TEMP_RANGE_MIN`` in ``AP_InertialSensor_tempcal.cpp``);
 * smooths the (often whole-degree) temperature readings in time without lag;
 * chooses each axis's order (up to 3, what both firmwares evaluate) by leave-one-
@@ -31,7 +31,7 @@ import numpy as np
 
 from .._validation import at_least, finite_array, positive
 from ..errors import GyrocalWarning, InputError
-from ..stillness import find_motion
+from ..segmentation.stillness import find_motion
 from .curve import MAX_ORDER, AccelDrift, BlockGrid, TemperaturePolynomial, check_axes, check_curve, fit_sensor
 from .temperature import temperature_course
 
@@ -89,7 +89,7 @@ class ThermalBias(TemperaturePolynomial):
     warnings: tuple[str, ...] = ()
     accel: AccelDrift | None = None
 
-    #: File kind (registered by :mod:`gyrocal.thermal_bias_file`, which holds the document code).
+    #: File kind (registered by :mod:`gyrocal.flight.thermal_bias_document`, which holds the document code).
     FORMAT: ClassVar[str] = "gyrocal.thermal-bias"
     VERSION: ClassVar[int] = 2
 

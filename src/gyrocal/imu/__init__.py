@@ -6,6 +6,8 @@ three known-angle turns). :func:`calibrate_imu` finds the still poses, fits the 
 from the gravity they show and the gyro from the turns between them, each with its
 covariance and goodness of fit. :mod:`gyrocal.imu.planning` predicts the accuracy of a pose
 plan before it is done.
+
+Layer 7 (the methods) of docs/architecture.md: imports the package root and layers 1 to 7 only.
 """
 
 from .accel import ACCEL_MODELS, AccelFit, fit_accelerometer, normal_gravity

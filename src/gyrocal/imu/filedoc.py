@@ -1,6 +1,6 @@
 """The calibration file's sections for a whole-IMU calibration: the gyro's ``fit`` and the ``accelerometer``.
 
-``accelerometer`` (the :class:`~gyrocal.sections.AccelerometerPart` keys, plus the ones this
+``accelerometer`` (the :class:`~gyrocal.results.sections.AccelerometerPart` keys, plus the ones this
 method adds):
 
 * ``units``: ``input`` (m/s^2, g or counts), ``output`` (m/s^2 or g), ``sensitivity`` (LSB per g

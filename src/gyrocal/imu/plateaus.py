@@ -1,6 +1,6 @@
 """Temperature plateaus of a chamber log: contiguous runs of samples at one temperature.
 
-A plateau is a run of samples with no break inside it (:attr:`gyrocal.timebase.TimeBase.breaks`:
+A plateau is a run of samples with no break inside it (:attr:`gyrocal.recording.timebase.TimeBase.breaks`:
 a jump in time or in the counter, as when the soak between plateaus was not recorded) whose
 temperature stays within ``tol`` of the run's first readings. Runs shorter than ``min_duration``
 (the ramp between set points) are dropped. Plateaus whose mean temperatures lie within ``tol``

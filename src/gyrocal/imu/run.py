@@ -3,7 +3,7 @@
 :func:`calibrate_recording` runs :func:`~gyrocal.imu.session.calibrate_imu` on a
 :class:`~gyrocal.recording.Recording` (on the sensor's own clock when its stamps are receive
 times, leaving out pose pairs across lost samples) and builds the
-:class:`~gyrocal.calibration.Calibration`: ``correction`` and ``parameters`` are the gyro's, in
+:class:`~gyrocal.results.calibration.Calibration`: ``correction`` and ``parameters`` are the gyro's, in
 the conventions of the other methods (``w_true = matrix @ (raw - offset)``), and the
 ``accelerometer`` section holds the accelerometer's correction, its parameters with their
 covariance, how well they fit, the poses, and the gyro's g-sensitivity when it was fitted. A log
@@ -19,12 +19,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..calibration import Calibration
 from ..errors import InputError
 from ..models import KG_INDEX, Affine, ScaleBias
-from ..observed import observe
+from ..observations.observed import observe
 from ..recording import Recording
-from ..timebase import TimeBase
+from ..recording.timebase import TimeBase
+from ..results.calibration import Calibration
 from ..units import STANDARD_GRAVITY, accel_scale, parse_rate_unit
 from .filedoc import accelerometer_section, gyro_fit_section
 from .session import ImuCalibrationResult, calibrate_imu
@@ -93,8 +93,8 @@ def implausible(cal: Calibration) -> str | None:
     (more than 20 % from 1 in physical units), or gyro counts whose sensitivity no vendor's setting comes near."""
     out = list(plausibility(cal))
     if cal.input_units == "counts" and cal.sensitivity is None:
-        from ..plausibility import Context
-        from ..plausibility import implausible as judge
+        from ..checks.plausibility import Context
+        from ..checks.plausibility import implausible as judge
 
         ctx = Context(units="counts", counts_scale=True, reference="angle", declared=float("nan"), sample_rate=1.0,
                       has_time=True)

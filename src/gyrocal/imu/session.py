@@ -23,10 +23,10 @@ from typing import Literal
 import numpy as np
 
 from .._validation import at_least, finite_array, positive
-from ..breaks import spans_break, split_spans
 from ..errors import InputError, SegmentationError
+from ..recording.breaks import spans_break, split_spans
+from ..segmentation.windows import Window
 from ..units import STANDARD_GRAVITY
-from ..windows import Window
 from ._fit import unchecked_warning
 from .accel import AccelFit, fit_accelerometer
 from .gyro import GyroFit, Turn, fit_gyroscope
@@ -194,10 +194,10 @@ def calibrate_imu(t, gyro, accel, *, gravity: float = STANDARD_GRAVITY, windows:
     min_static : float
         Shortest still pose the detector keeps [s].
     gaps : sequence of int
-        Samples before which samples are missing (:attr:`gyrocal.timebase.TimeBase.gaps`): a turn
+        Samples before which samples are missing (:attr:`gyrocal.recording.timebase.TimeBase.gaps`): a turn
         across a gap has lost angle, so the pose pair around it is left out.
     breaks : sequence of int
-        Samples that start a new part of a log that is not contiguous (:attr:`gyrocal.timebase.TimeBase.breaks`):
+        Samples that start a new part of a log that is not contiguous (:attr:`gyrocal.recording.timebase.TimeBase.breaks`):
         no pose, pair or turn spans one.
     threshold : float or None
         Multiplier of the detector's stillness thresholds; None tries several

@@ -4,9 +4,12 @@ Formats: delimited text (pyarrow when installed), Parquet (``arrow`` extra), ROS
 MCAP bags (``ros`` extra), PX4 ULog (``ulog`` extra) and ArduPilot DataFlash (``dataflash``
 extra) logs. Everything comes back as a checked
 :class:`~gyrocal.recording.Recording` in internal units.
+
+Layer 3 (reading files and observations) of docs/architecture.md: imports the package root and layers 1 to 3
+only.
 """
 
-from ..saturation import find_saturation
+from ..recording.saturation import find_saturation
 from .accel_log import attach_accelerometer
 from .flightlog import read_flight_log
 from .profile import read_profile

@@ -7,13 +7,14 @@ import math
 import numpy as np
 
 from .._validation import positive
-from ..breaks import BREAK_S, counter_breaks, find_counter, join_backward_parts
+from .._white import robust_difference_std
 from ..choices import AccelUnit, SaturationPolicy, values
 from ..constants import STANDARD_GRAVITY
 from ..errors import InputError, NonFiniteInputError, SaturationError, UnitError
 from ..recording import Recording
-from ..saturation import find_saturation, stuck_runs
-from ..timebase import nominal_period
+from ..recording.breaks import BREAK_S, counter_breaks, find_counter, join_backward_parts
+from ..recording.saturation import find_saturation, stuck_runs
+from ..recording.timebase import nominal_period
 from ..units import parse_input_unit, parse_rate_unit, unit_factor
 from ._columns import ACCEL, NUMERIC
 from ._rows import drop_nan_rows, time_in_seconds
@@ -53,7 +54,7 @@ def _check_finite(data: dict, source: str, known_finite: tuple[str, ...] = ()) -
 
 
 def _check_time(t: np.ndarray, source: str) -> float:
-    """Check that time increases; return the nominal rate [Hz] (:func:`gyrocal.timebase.nominal_period`)."""
+    """Check that time increases; return the nominal rate [Hz] (:func:`gyrocal.recording.timebase.nominal_period`)."""
     increasing = t[1:] > t[:-1]
     if not increasing.all():
         i = int(np.argmin(increasing))
@@ -68,7 +69,7 @@ def _check_time(t: np.ndarray, source: str) -> float:
             f"{source}: {'a duplicated timestamp' if tied else 'time going backwards'} at data row {i + 2} "
             f"(t={float(t[i])} then {float(t[i + 1])}); times must increase strictly: {fix}"
         )
-    # the mean step of the sensor clock, robust to gaps (gyrocal.timebase): never the median step of bursty
+    # the mean step of the sensor clock, robust to gaps (gyrocal.recording.timebase): never the median step of bursty
     # receive-time stamps, and block means of 64 steps average away the 0.24 us quantum of epoch stamps
     step = nominal_period(t)
     fs = 1.0 / step
@@ -84,10 +85,9 @@ def _check_time(t: np.ndarray, source: str) -> float:
 
 
 def _noise(raw: np.ndarray) -> float:
-    """Per-sample noise, robust to turns: median |first difference| / (0.6745 sqrt 2), on the quietest
+    """Per-sample noise, robust to turns (:func:`~gyrocal._white.robust_difference_std`), on the quietest
     axis so that one shaking axis cannot make rad/s data look like deg/s."""
-    d = np.abs(np.diff(raw[:NOISE_SAMPLES + 1], axis=0))
-    return float(np.min(np.median(d, axis=0))) / (0.6745 * math.sqrt(2.0))
+    return float(np.min(robust_difference_std(np.diff(raw[:NOISE_SAMPLES + 1], axis=0))))
 
 
 def _check_units(raw: np.ndarray, unit: str, sensitivity: float | None, source: str, peak: float) -> None:
@@ -308,7 +308,7 @@ def build_recording(
 
 def _time_column(data: dict, extra: dict, n: int, rows, sample_rate, time_units, source: str, notes: list):
     """``(t, has_time, fs, breaks)``: the stamps [s] (parts glued out of order laid end to end), whether they
-    came from the data, the nominal rate and the breaks (:mod:`gyrocal.breaks`)."""
+    came from the data, the nominal rate and the breaks (:mod:`gyrocal.recording.breaks`)."""
     breaks: tuple = ()
     if "t" in data:
         t, has_time = np.asarray(data["t"], dtype=float), True  # a time column wins over sample_rate

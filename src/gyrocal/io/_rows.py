@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from ..timebase import nominal_period
+from ..recording.timebase import nominal_period
 from ._columns import NUMERIC
 
 #: Seconds per unit of a time column.

@@ -30,7 +30,7 @@ import numpy as np
 
 from .._validation import positive
 from ..errors import FileFormatError, InputError
-from ..windows import Window
+from ..segmentation.windows import Window
 
 __all__ = ["read_windows"]
 

@@ -5,7 +5,9 @@ moves is cut to its longest still stretch with a warning), computes the overlapp
 deviation of each gyro and accelerometer axis (``allantools``) and reads the white-noise
 density, the bias instability and the random walk of the bias for each axis and for the
 sensor, each with a confidence interval from the equivalent degrees of freedom. The report's
-file is :mod:`gyrocal.noise_file` (``save_noise``, ``load_noise``, ``noise_density_arg``).
+file is :mod:`gyrocal.noise.document` (``save_noise``, ``load_noise``, ``noise_density_arg``).
+
+Layer 7 (the methods) of docs/architecture.md: imports the package root and layers 1 to 7 only.
 """
 
 from .allan import ONE_SIGMA, allan_deviation

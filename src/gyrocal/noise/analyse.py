@@ -17,7 +17,7 @@ from .._validation import finite_array, positive
 from ..choices import MotionPolicy, values
 from ..errors import GyrocalWarning, InputError, UnitError
 from ..recording import Recording
-from ..stillness import find_motion
+from ..segmentation.stillness import find_motion
 from .allan import MIN_SAMPLES, ONE_SIGMA, allan_deviation
 from .figures import read_figures
 from .report import NoiseReport, SensorNoise

@@ -1,7 +1,7 @@
 """The noise report of a log at rest: each sensor's Allan deviation and figures, and where they came from.
 
-The report's file, ``format: gyrocal.noise``, is read and written by :mod:`gyrocal.noise_file`
-(core numerics do not hold file code); :mod:`gyrocal.files` knows it by name, so ``load``,
+The report's file, ``format: gyrocal.noise``, is read and written by :mod:`gyrocal.noise.document`
+(core numerics do not hold file code); :mod:`gyrocal.results.files` knows it by name, so ``load``,
 ``save`` and ``to_document`` handle it like any kind.
 """
 

@@ -12,10 +12,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..calibration import Calibration
 from ..recording import Recording
+from ..results.calibration import Calibration
+from ..segmentation.windows import Window
 from ..units import RATE_UNITS, from_rad_s
-from ..windows import Window
 from .figure import new_figure, outside_legend
 
 __all__ = ["calibration_figure", "display_rates", "plot_corrected", "plot_windows"]

@@ -1,4 +1,10 @@
-"""Automatic segmentation of calibration sessions into rotation and static windows."""
+"""Automatic segmentation of calibration sessions into rotation and static windows.
+
+Owns the :class:`~.windows.Window` type (:mod:`.windows`), detection and given windows, and
+whether a log is still (:mod:`.stillness`).
+
+Layer 2 (windows) of docs/architecture.md: imports the package root and layers 1 to 2 only.
+"""
 
 from ._given import given_windows
 from ._measure import measure_turn, standstill_level

@@ -20,10 +20,10 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..errors import InputError
-from ..windows import Window
 from ._measure import measure_turn, standstill_level
 from ._result import Segmentation
 from ._select import AGREE_TOL
+from .windows import Window
 
 __all__ = ["PLAUSIBLE", "given_windows"]
 
@@ -60,7 +60,7 @@ def given_windows(rec, windows: Sequence[Window], reference: str, speed, angle, 
     n, fs = len(rec), rec.sample_rate
     for w in windows:
         if not isinstance(w, Window):
-            raise InputError(f"windows must hold gyrocal.windows.Window objects, got {type(w).__name__}")
+            raise InputError(f"windows must hold gyrocal.segmentation.windows.Window objects, got {type(w).__name__}")
         if w.stop > n:
             raise InputError(f"window {w.label or ''} {w.start}:{w.stop} ends after the recording ({n} samples)")
     base = standstill_level(rec, windows)

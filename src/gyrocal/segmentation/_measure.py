@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..recording import Recording
-from ..windows import Window
 from ._motion import static_level
+from .windows import Window
 
 __all__ = ["measure_turn", "standstill_level"]
 

@@ -12,11 +12,11 @@ import math
 
 import numpy as np
 
-from ..windows import Window
 from ._motion import Motion, runs_of
 from ._result import NO_PLATEAU
 from ._select import AGREE_TOL, K_RANGE, select_by_axis
 from ._turns import MAX_OFF_AXIS_DEG, axis_sign
+from .windows import Window
 
 __all__ = ["speed_turns"]
 

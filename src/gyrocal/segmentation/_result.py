@@ -10,8 +10,8 @@ from typing import Literal
 import numpy as np
 
 from ..errors import SegmentationError
-from ..windows import Window
 from ._advice import measured_turns
+from .windows import Window
 
 __all__ = ["Segmentation", "describe_found"]
 

@@ -23,13 +23,13 @@ import numpy as np
 from .._validation import positive
 from ..errors import InputError, SegmentationError
 from ..recording import Recording
-from ..windows import Window
 from ._advice import advise
 from ._motion import detect_motion, runs_of
 from ._plateaus import speed_turns
 from ._result import Segmentation
 from ._select import AGREE_TOL, K_RANGE
 from ._turns import angle_turns
+from .windows import Window
 
 __all__ = ["segment"]
 

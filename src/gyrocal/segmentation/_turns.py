@@ -13,9 +13,9 @@ import math
 
 import numpy as np
 
-from ..windows import Window
 from ._motion import Motion
 from ._select import AGREE_TOL, K_RANGE, select_by_axis
+from .windows import Window
 
 __all__ = ["MAX_OFF_AXIS_DEG", "angle_turns", "axis_sign"]
 

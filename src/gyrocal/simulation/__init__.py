@@ -4,6 +4,9 @@ Readings from :func:`simulate_servo`, :func:`simulate_turntable`, :func:`simulat
 and :func:`simulate_still` (a static log, or a board warming up) are :class:`~gyrocal.recording.Recording` objects, so simulated
 and real data travel one path. :func:`paper_observations` (per sample) and
 :func:`simulate_observations` (exact fast path) draw the servo method's window statistics.
+
+Layer 8 (firmware, exports, simulation, figures and the store) of docs/architecture.md: imports the package
+root and layers 1 to 8 only, and not export, firmware, io, jobs, plotting, store, thermal.
 """
 
 from .fast import simulate_observations

@@ -23,7 +23,7 @@ from .._validation import positive
 from ..errors import InputError
 from ..models import CalibrationModel
 from ..recording import Recording
-from ..windows import Window
+from ..segmentation.windows import Window
 from .gyro import VirtualGyro
 from .windows import PAPER_AXES, axis_vector
 

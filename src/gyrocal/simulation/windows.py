@@ -22,9 +22,10 @@ from collections.abc import Sequence
 import numpy as np
 
 from .._validation import finite_array, positive
+from .._white import difference_variance
 from ..errors import InputError
 from ..observations import ObservationSet
-from ..windows import axis_vector
+from ..segmentation.windows import axis_vector
 
 __all__ = ["PAPER_AXES", "axis_vector", "paper_observations"]
 
@@ -67,7 +68,7 @@ def check_protocol_args(k, b, speed, sample_rate, noise_std, jitter, misalignmen
 def _reduce(m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Window mean, mean of squares and first-difference noise variance of (B, n, 3) readings."""
     d = np.diff(m, axis=1)
-    return m.mean(axis=1), np.einsum("bni,bni->bi", m, m) / m.shape[1], np.einsum("bni,bni->bi", d, d) / (2 * d.shape[1])
+    return m.mean(axis=1), np.einsum("bni,bni->bi", m, m) / m.shape[1], difference_variance(d, axis=1)
 
 
 def paper_observations(

@@ -11,6 +11,9 @@ package imports them only when a store is opened, so ``import gyrocal.store`` wo
 Modules: :mod:`.urls` (store locations), :mod:`.records` (the record and its field checks),
 :mod:`.schema` (tables, SQLAlchemy Core), :mod:`.migrate` (Alembic, bundled migrations),
 :mod:`.engine` (connections, SQLite locking, retries, one-line errors), :mod:`.store` (the API).
+
+Layer 8 (firmware, exports, simulation, figures and the store) of docs/architecture.md: imports nothing of
+gyrocal but the package root.
 """
 
 from __future__ import annotations

@@ -2,6 +2,9 @@
 
 Each study is one module with ``run(out, ..., progress=None) -> StudyOutput`` and
 ``work_units()``; :func:`run_study` picks one by its command-line name.
+
+Layer 9 (studies, capture and the station) of docs/architecture.md: imports the package root and layers 1 to 9
+only.
 """
 
 from __future__ import annotations

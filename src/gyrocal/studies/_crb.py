@@ -21,7 +21,7 @@ def crb_std(k, b, *, speed: float, noise_std: float, sample_rate: float) -> np.n
     sample_rate : float
         Sampling rate [Hz].
     """
-    from ..design import Design, predicted_std
+    from ..planning.design import Design, predicted_std
 
     design = Design.paper_six(speed)
     k, b = np.atleast_2d(k), np.atleast_2d(b)

@@ -5,6 +5,8 @@ least squares (:mod:`.fit`) -> a temperature table with 3-node Lagrange
 interpolation (:mod:`.lagrange`) and a smooth polynomial alternative
 (:mod:`.smooth`) -> compensation and file (:mod:`.model`) -> evaluation against a
 reference (:mod:`.evaluate`, :mod:`.report`).
+
+Layer 7 (the methods) of docs/architecture.md: imports the package root and layers 1 to 7 only.
 """
 
 from ._warn import DroppedStepsWarning, SaturatedStepsWarning, ThermalRangeWarning, ThermalWarning

@@ -21,7 +21,7 @@ Document layout (``format: gyrocal.thermal``, ``version: 2``; see docs/files.md)
 order); ``kg_user`` has B in input units and K scaled by output/input unit factors, so
 ``w_in = K_user w_out + B_user``; ``correction`` is the canonical
 ``w_out = matrix @ (raw - offset)`` in user units. The smooth model is stored for internal
-``kg``. Version 1 files are upgraded on load by :mod:`gyrocal.legacy`.
+``kg``. Version 1 files are upgraded on load by :mod:`gyrocal.results.legacy`.
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ from ..choices import OutOfRange, TableModel, values
 from ..errors import FileFormatError, InputError, UnitError
 from ..models import KG_NAMES, kg_to_kb
 from ..recording import Recording
-from ..sections import FitQuality, section
+from ..results.sections import FitQuality, section
 from ..units import RateUnit, parse_rate_unit, unit_factor
 from ._warn import ThermalRangeWarning
 from .lagrange import check_nodes, interpolate, range_policy

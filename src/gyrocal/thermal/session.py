@@ -18,7 +18,7 @@ import numpy as np
 from .._validation import positive
 from ..errors import InputError
 from ..recording import Recording
-from ..saturation import find_saturation
+from ..recording.saturation import find_saturation
 from ._warn import DroppedStepsWarning, SaturatedStepsWarning
 
 __all__ = ["AXES", "Steps", "drop_saturated", "drop_unstable", "find_steps", "session_steps"]

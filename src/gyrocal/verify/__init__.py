@@ -12,6 +12,8 @@ beside a high-grade reference (Tables IV-V, Figs. 7-10). Two sensors, two clocks
 * :func:`compare_calibrations` compares calibrations of one unit parameter by parameter.
 
 Numerics only: no files, no command line.
+
+Layer 7 (the methods) of docs/architecture.md: imports the package root and layers 1 to 7 only.
 """
 
 from .alignment import Alignment, AlignmentError, align

@@ -22,9 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..calibration import Calibration
 from ..errors import InputError
 from ..models import KG_NAMES, ScaleBias
+from ..results.calibration import Calibration
 from ..thermal.model import ThermalCalibration
 
 __all__ = ["Comparison", "compare_calibrations"]
