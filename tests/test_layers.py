@@ -31,6 +31,8 @@ FORBIDDEN: dict[str, set[str]] = {
     "studies": {"cli"},
     # the calibration store keeps results; it computes nothing and knows no file format or front end
     "store": _FRONT | {"files", "firmware", "thermal", "calibration", "pipeline"},
+    # the jobs are the commands' cores: the CLI and the station drive them, never the reverse
+    "jobs": {"cli", "store", "station", "studies", "simulation"},
 }
 #: Components that never use the store (it is for front ends and batch jobs, not for the numerics).
 for _core in ("models", "observations", "estimators", "design", "segmentation", "windows", "recording", "units",

@@ -45,7 +45,7 @@ class CalibrateJob(Job):
             import math
 
             angle = 2 * math.pi  # one full turn per window, as the command's default
-        unit = self.output_units or (None if rec.units == "counts" else rec.units)
+        unit = self.output_units or ("deg/s" if rec.source_units == "counts" else rec.source_units)  # as the CLI
         run = calibrate(rec, speed=speed, angle=angle, method=self.method, windows=win, noise_std=self.noise_std,
                         output_units=unit, reference_sd=self.reference_sd)
         cal = _with_notes(run.calibration, read_notes)
