@@ -17,9 +17,9 @@ import pathlib
 import subprocess
 import sys
 
-import numpy as np
 import pytest
 from cli_runner import invoke
+from thermal_sessions import thermal_session
 
 from gyrocal.errors import InputError
 from gyrocal.jobs import JOBS, make_job, run_job
@@ -31,22 +31,6 @@ DATA = pathlib.Path(__file__).resolve().parents[1] / "src" / "gyrocal" / "data"
 def _simulate(path, *args):
     code, _, err = invoke("simulate", "-o", path, *args)
     assert code == 0, err
-    return path
-
-
-def _thermal_session(path):
-    """Three temperatures, three table rates, 3-s steps at 50 Hz (the turntable simulator, seeded)."""
-    from gyrocal.io import write_csv
-    from gyrocal.simulation.thermal_truth import ThermalTruth
-    from gyrocal.simulation.turntable import TurntableProtocol, simulate_turntable
-
-    gyro = ThermalTruth().gyro(np.radians(0.05), full_scale=np.radians(300.0))
-    rec = simulate_turntable(gyro, TurntableProtocol(temps=(0.0, 20.0, 40.0), rates=(0.0, 50.0, 200.0),
-                                                     step_duration=3.0), sample_rate=50.0,
-                             rng=np.random.default_rng(23))
-    d = np.degrees(rec.gyro)
-    write_csv(path, {"t": rec.t, "gx": d[:, 0], "gy": d[:, 1], "gz": d[:, 2], "temp": rec.temp,
-                     "table_rate": np.degrees(rec.table_rate), "axis": rec.axis})
     return path
 
 
@@ -62,7 +46,7 @@ def cases(tmp_path_factory):
     warm = _simulate(d / "warm.csv", "--protocol", "static", "--duration", "600", "--sample-rate", "10",
                      "--noise", "0.005", "--temp-start", "-5", "--temp-end", "50", "--warmup-tau", "150",
                      "--temp-quantum", "1", "--bias-tempco", "2e-4,-1e-4,5e-5;-3e-6,0,2e-6;5e-8,0,0", "--seed", "3")
-    session = _thermal_session(d / "thermal.csv")
+    session = thermal_session(d / "thermal.csv")
     cal = d / "example.json"
     code, _, err = invoke("calibrate", "--example", "-o", cal)
     assert code == 0, err
