@@ -45,6 +45,8 @@ FORBIDDEN: dict[str, set[str]] = {
     "simulation": {"io", "thermal", "plotting", "export", "firmware", "store", "jobs"},
     "plotting": {"store", "jobs", "firmware"},
     "export": {"store", "jobs"},
+    # the jobs are the commands' cores: the CLI and the station drive them, never the reverse
+    "jobs": {"store", "simulation"},
 }
 #: Packages that import nothing of gyrocal but the package root's vocabulary.
 ROOT_ONLY = {"store"}

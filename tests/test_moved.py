@@ -13,8 +13,9 @@ import subprocess
 import sys
 from pathlib import Path
 
-from gyrocal._moved import MOVED
 from test_layers import _imports
+
+from gyrocal._moved import MOVED
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -15,9 +15,9 @@ import hashlib
 import json
 import math
 
-import numpy as np
 import pytest
 from cli_runner import invoke, refused
+from thermal_sessions import thermal_session
 
 from gyrocal.store import open_store
 
@@ -26,22 +26,6 @@ DEG = math.pi / 180
 
 def _sha(path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
-
-
-def _thermal_session(path):
-    """Three temperatures, three table rates, 3-s steps at 50 Hz (the shape of test_thermal_cli's session)."""
-    from gyrocal.io import write_csv
-    from gyrocal.simulation.thermal_truth import ThermalTruth
-    from gyrocal.simulation.turntable import TurntableProtocol, simulate_turntable
-
-    gyro = ThermalTruth().gyro(np.radians(0.05), full_scale=np.radians(300.0))
-    rec = simulate_turntable(gyro, TurntableProtocol(temps=(0.0, 20.0, 40.0), rates=(0.0, 50.0, 200.0),
-                                                     step_duration=3.0), sample_rate=50.0,
-                             rng=np.random.default_rng(23))
-    d = np.degrees(rec.gyro)
-    write_csv(path, {"t": rec.t, "gx": d[:, 0], "gy": d[:, 1], "gz": d[:, 2], "temp": rec.temp,
-                     "table_rate": np.degrees(rec.table_rate), "axis": rec.axis})
-    return path
 
 
 def _simulate(path, *args):
@@ -62,7 +46,7 @@ def inputs(tmp_path_factory):
                                   "20", "--noise", "0.005", "--temp-start", "-5", "--temp-end", "50",
                                   "--warmup-tau", "300", "--temp-quantum", "1", "--bias-tempco",
                                   "2e-4,-1e-4,5e-5;-3e-6,0,2e-6;5e-8,0,0", "--seed", "3"),
-        "thermal": _thermal_session(d / "thermal.csv"),
+        "thermal": thermal_session(d / "thermal.csv"),
     }
 
 

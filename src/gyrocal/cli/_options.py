@@ -147,20 +147,13 @@ AcceptImplausible = Annotated[bool, typer.Option(
 
 def judge_plausible(doc: dict, diagnosis: str | None, accept: bool) -> dict:
     """The result document `doc`, refused (one line, exit 2, before anything is written) when `diagnosis` says it
-    is implausible, unless `accept`: then with the diagnosis among its warnings (the file's own, the fit's, or the
-    settings' for a thermal table without a fit section)."""
-    if diagnosis is None:
-        return doc
-    if not accept:
-        raise InputError(f"implausible result, nothing written: {diagnosis}", param="accept_implausible",
-                         hint="if every declaration is right, give {param} to write it with this warning in the file")
-    from .app import warn
+    is implausible, unless `accept`: then with the diagnosis among its warnings (:func:`gyrocal.jobs.result.judge`),
+    which is also printed."""
+    from ..jobs.result import judge
 
-    text = f"written with --accept-implausible: {diagnosis}"
-    warn(text)
-    fit = doc.get("fit")
-    if isinstance(doc.get("warnings"), list):  # the file's own warnings (thermal-bias)
-        return {**doc, "warnings": doc["warnings"] + [text]}
-    if isinstance(fit, dict):  # a calibration's fit section
-        return {**doc, "fit": {**fit, "warnings": list(fit.get("warnings") or []) + [text]}}
-    return {**doc, "settings": {**(doc.get("settings") or {}), "warnings": [text]}}
+    doc, text = judge(doc, diagnosis, accept)
+    if text is not None:
+        from .app import warn
+
+        warn(text)
+    return doc

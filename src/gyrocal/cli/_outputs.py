@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
 from typing import Callable, Iterable
@@ -76,23 +75,16 @@ def same_text(text: str) -> Callable[[Path], bool]:
 
 def _json_object(path: Path) -> dict | None:
     """The JSON object in `path`, or None when it holds anything else."""
-    try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
-        return None
-    return doc if isinstance(doc, dict) else None
+    from ..jobs.result import json_object
+
+    return json_object(path)
 
 
 def same_document(doc: dict) -> Callable[[Path], bool]:
     """A `replaceable` test: the file is JSON holding `doc` (apart from which gyrocal wrote it)."""
-    def kept(d: dict) -> dict:
-        out = {k: v for k, v in d.items() if k != "created_by"}
-        if isinstance(out.get("unit"), dict):  # the same unit's result, made again at another time
-            out["unit"] = {k: v for k, v in out["unit"].items() if k not in ("created", "software")}
-        return out
+    from ..jobs.result import same_document as same
 
-    mine = kept(doc)
-    return lambda path: (old := _json_object(path)) is not None and kept(old) == mine
+    return same(doc)
 
 
 def json_format(fmt: str) -> Callable[[Path], bool]:

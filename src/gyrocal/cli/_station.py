@@ -1,8 +1,8 @@
 """The station's flags, shared by every command that writes a result: identity, limits, store.
 
 A command takes them with :func:`station_flags` (``--unit`` ... ``--store``, checked before its body
-runs) and ends in three calls: :func:`finish` gives the result document its ``unit`` section and its
-acceptance, :func:`write_and_store` writes it atomically (when the command has an output file) and
+runs), runs its job (:mod:`gyrocal.jobs`) and ends in three calls on the job's result: :func:`finish`
+gives the result document its ``unit`` section and its acceptance, :func:`write_and_store` writes it atomically (when the command has an output file) and
 adds it to the store, and :func:`conclude` says where it went and the verdict, with the exit code
 (0 pass or no limits, 1 fail). Library imports happen inside the functions, so ``gyrocal --help``
 stays fast.
@@ -134,12 +134,23 @@ def station_flags(command):
     return with_flags
 
 
-def finish(doc: dict, flags: StationFlags, *, inputs, device_id: int | None = None) -> tuple[dict, str | None]:
-    """Stamp `doc` with the unit, as found / as left (with --store) and the acceptance; the document and the verdict.
+def _is_result(doc) -> bool:
+    """`doc` is a job's result (:class:`gyrocal.jobs.result.JobResult`), not a bare document."""
+    return hasattr(doc, "document") and hasattr(doc, "kind")
 
-    The caller writes the returned document (atomically) before the store is written, so a stored
-    record always has its file; the verdict is None without limits.
+
+def finish(doc, flags: StationFlags, *, inputs=None, device_id: int | None = None):
+    """Stamp a job's result (or a bare document) with the unit, as found / as left (with --store) and the
+    acceptance; the stamped result (or document) and the verdict.
+
+    A job's result gives its own inputs and device id. The caller writes the returned document
+    (atomically) before the store is written, so a stored record always has its file; the verdict is
+    None without limits.
     """
+    if _is_result(doc):
+        stamped, verdict = finish(doc.document, flags, inputs=doc.inputs if inputs is None else inputs,
+                                  device_id=doc.device_id if device_id is None else device_id)
+        return doc.with_document(stamped), verdict
     files = [Path(p) for p in inputs if p is not None]
     identity = flags.identity()
     if identity is not None:
@@ -197,12 +208,16 @@ def store_result(doc: dict, flags: StationFlags, verdict: str | None, *, kind: s
                          input_sha256=hashes[0] if len(hashes) == 1 else hashes, job=job, args=args)
 
 
-def write_and_store(doc: dict, flags: StationFlags, output: Path | None, verdict: str | None, *, inputs, kind: str,
-                    job: str, args: str = "") -> int | None:
-    """Write the finished `doc` to `output` atomically (None: nothing on disk), then add it to the store.
+def write_and_store(doc, flags: StationFlags, output: Path | None, verdict: str | None, *, inputs=None,
+                    kind: str | None = None, job: str | None = None, args: str = "") -> int | None:
+    """Write the finished job's result (or bare document) to `output` atomically (None: nothing on disk),
+    then add it to the store; a job's result gives its own inputs, kind and job name.
 
     The file comes first, so a stored record always has its file; the record id, or None without --store.
     """
+    if _is_result(doc):
+        inputs = doc.inputs if inputs is None else inputs
+        kind, job, doc = kind or doc.kind, job or doc.job, doc.document
     if output is not None:
         from .._jsonfile import write_json
 
@@ -210,8 +225,10 @@ def write_and_store(doc: dict, flags: StationFlags, output: Path | None, verdict
     return store_result(doc, flags, verdict, kind=kind, job=job, args=args, inputs=inputs)
 
 
-def conclude(console, doc: dict, flags: StationFlags, record: int | None, verdict: str | None) -> None:
-    """A command's last lines: where the record went, the acceptance; exit 1 when it failed."""
+def conclude(console, doc, flags: StationFlags, record: int | None, verdict: str | None) -> None:
+    """A command's last lines (of a job's result, or a bare document): where the record went, the acceptance;
+    exit 1 when it failed."""
+    doc = doc.document if _is_result(doc) else doc
     if record is not None:
         console.print(f"stored as record {record} in {flags.store}", highlight=False)
     print_verdict(console, doc)

@@ -1,8 +1,9 @@
 """Command ``batch``: every row of a manifest through its command, on a process pool, into one store.
 
 Each row runs the very command a user would type (``gyrocal calibrate FILE ARGS --unit SERIAL --store
-URL ...``) inside a worker process: one job interface for every kind of calibration, and the command's
-own refusals, verdicts and atomic writes. A row already stored (same input SHA-256, job and args) is
+URL ...``) inside a worker process: the command parses the row's flags into the job of that name
+(:func:`gyrocal.jobs.run_job`, one job interface for every kind of calibration) and stamps, writes and
+stores its result with the station's calls, with the job's own refusals, verdicts and atomic writes. A row already stored (same input SHA-256, job and args) is
 skipped, and counts with the outcome it had; a refused row is recorded with its reason.
 """
 

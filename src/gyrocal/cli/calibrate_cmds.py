@@ -18,7 +18,7 @@ import typer
 
 from ..choices import Method
 from ..errors import GyrocalError, InputError
-from ._options import AcceptImplausible, in_unit, judge_plausible, noise_density_option
+from ._options import AcceptImplausible, in_unit, noise_density_option
 from ._outputs import check_output, same_document
 from ._reading import READING, read_from_flags, required_units
 from ._references import density_to_internal, noise_to_internal, rate_unit_of, reference_of
@@ -212,7 +212,7 @@ def calibrate(
 ) -> None:
     """Estimate scale and bias from a recording of turns; print them with 1-sigma; write the calibration file."""
     # long function: the command's steps in order (flags, reading, fit, outputs, station), each a call of its own
-    from ..pipeline import calibrate as run_calibration
+    from ..jobs import run_job
 
     truth_path = None
     if example:
@@ -236,47 +236,31 @@ def calibrate(
     rec = read_from_flags(recording, units=units, columns=columns, skip_rows=skip_rows, sample_rate=sample_rate,
                           sensitivity=sensitivity, output_units=output_units, topic=topic, saturation=saturation,
                           no_unit_check=no_unit_check, imu=imu, time_units=time_units, nan=nan, notes=read_notes)
-    win = _windows_from_file(windows, rec)
     noise = noise_to_internal(noise_std, units, rate_unit, sensitivity)
     if noise_density is not None:
         noise = density_to_internal(noise_density, noise_std, rec)
-    run = run_calibration(rec, speed=speed_rad, angle=angle_rad, method=method, windows=win, noise_std=noise,
-                          output_units=rate_unit, reference_sd=ref_sd)
-    cal = _with_notes(run.calibration, read_notes)
-    inputs = (Path(recording), windows)
-    doc, verdict = finish(judge_plausible(cal.to_document(), run.implausible, accept_implausible), flags, inputs=inputs)
-    check_output(output, inputs=inputs, force=force, replaceable=same_document(doc),
+    result = run_job("calibrate", recording=rec, sources=(Path(recording),), windows=windows, speed=speed_rad,
+                     angle=angle_rad, method=method, noise_std=noise, output_units=rate_unit, reference_sd=ref_sd,
+                     accept_implausible=accept_implausible, notes=tuple(read_notes))
+    if result.implausible is not None:
+        warn(result.implausible)
+    run = result.value
+    result, verdict = finish(result, flags)
+    check_output(output, inputs=result.inputs, force=force, replaceable=same_document(result.document),
                  holds="a different calibration or another file")
-    check_output(plot, flag="--plot", inputs=inputs + (output,), outputs=(output,), force=True)
+    check_output(plot, flag="--plot", inputs=result.inputs + (output,), outputs=(output,), force=True)
     # files first: a reader that closes stdout early (| head) must not cost the outputs
     if plot is not None:
-        from ..segmentation.windows import Window
+        from ..plotting import save_figure
 
-        windows_used = [Window.from_dict(d) for d in cal.windows]
-        _save_plot(plot, rec, windows_used, cal, speed_rad, f"{Path(recording).name}: {reference} reference")
-    record = write_and_store(doc, flags, output, verdict, inputs=inputs, kind="calibration", job="calibrate")
+        save_figure(result.figures["calibration"](), plot)
+    record = write_and_store(result, flags, output, verdict)
     if example:
         console.print(intro, highlight=False, soft_wrap=True)
-    _print_calibration(run, None if truth_path is None else _truth_calibration(truth_path, cal))
+    _print_calibration(run, None if truth_path is None else _truth_calibration(truth_path, run.calibration))
     if output is not None:
         console.print(f"wrote {output}" + (f" and {plot}" if plot is not None else ""), highlight=False)
-    conclude(console, doc, flags, record, verdict)
-
-
-def _with_notes(cal, notes: list):
-    """The calibration with the reading's notes (rows dropped, ms stamps recognised) first in its fit's notes."""
-    import dataclasses
-
-    if not notes or cal.fit is None:
-        return cal
-    return dataclasses.replace(cal, fit={**cal.fit, "notes": list(notes) + list(cal.fit.get("notes", []))})
-
-
-def _save_plot(path: Path, rec, windows, cal, speed_rad, title: str) -> None:
-    from ..plotting import save_figure
-    from ..plotting.calibration import calibration_figure
-
-    save_figure(calibration_figure(rec, windows, cal, speed=speed_rad, title=title), path)
+    conclude(console, result, flags, record, verdict)
 
 
 @app.command()

@@ -10,11 +10,11 @@ from typing import Annotated, Optional
 import typer
 
 from ..constants import STANDARD_GRAVITY
-from ._options import AcceptImplausible, judge_plausible
+from ._options import AcceptImplausible
 from ._outputs import check_output, json_format
 from ._reading import READING, read_from_flags, required_units
 from ._station import StationFlags, conclude, finish, station_flags, write_and_store
-from .app import app, console
+from .app import app, console, warn
 
 __all__ = ["thermal_bias"]
 
@@ -58,19 +58,6 @@ def _summary(tb, unit: str, factor: float, title: str | None = None):
     return table
 
 
-def _implausible(tb, rec, log: Path, fs: float) -> str | None:
-    """The plausibility rule on a still log whose unit was declared (a flight log's unit is its format's)."""
-    import numpy as np
-
-    from ..checks.plausibility import still_units
-    from ..io.flightlog import flight_log_kind
-
-    if log.is_file() and flight_log_kind(log) is not None or rec.source_units not in ("deg/s", "rad/s"):
-        return None
-    deg = 180 / math.pi
-    return still_units(tb.bias_at([tb.tref])[0] * deg, np.asarray(tb.noise_std) * deg / math.sqrt(fs), rec.source_units)
-
-
 @app.command("thermal-bias")
 @station_flags
 def thermal_bias(
@@ -100,30 +87,26 @@ def thermal_bias(
 ) -> None:
     """Fit gyro bias (and accelerometer offset change) against temperature for PX4 and ArduPilot (then
     'gyrocal export --format px4' or ardupilot)."""
-    from ..flight import ThermalBias, fit_thermal_bias
-    from ..results.files import to_document
+    from ..flight import ThermalBias
 
     check_output(output, inputs=(log,), force=force, replaceable=json_format(ThermalBias.FORMAT))
     accel = {"accel_units": accel_units, "accel_sensitivity": accel_sensitivity, "gravity": gravity}
     rec, source = _read(log, units, columns, sample_rate, sensitivity, output_units, imu, accel)
-    if rec.temp is None:
-        from ..errors import InputError
+    from ..io.flightlog import flight_log_kind
+    from ..jobs import run_job
 
-        raise InputError(f"{log.name} has no temperature column; a thermal-bias fit needs one", param="columns",
-                         hint="map it with {param} temp=NAME")
-    fs = (len(rec) - 1) / float(rec.t[-1] - rec.t[0]) if rec.has_time else rec.sample_rate
-    source["units"] = rec.source_units
-    if rec.accel is not None:
-        source["accel_units"] = rec.accel_source_units
-    tb = fit_thermal_bias(rec.gyro, rec.temp, fs, max_order=max_order, min_span=min_span, source=source,
-                          accel=rec.accel)
-    doc = judge_plausible(to_document(tb), _implausible(tb, rec, log, fs), accept_implausible)
-    doc, verdict = finish(doc, flags, inputs=(log,), device_id=source.get("device_id"))
-    record = write_and_store(doc, flags, output, verdict, inputs=(log,), kind="thermal-bias", job="thermal-bias")
+    result = run_job("thermal-bias", recording=rec, sources=(log,), source=source, max_order=max_order,
+                     min_span=min_span, flight_log=log.is_file() and flight_log_kind(log) is not None,
+                     accept_implausible=accept_implausible)
+    if result.implausible is not None:
+        warn(result.implausible)
+    tb, rec, fs = result.value
+    result, verdict = finish(result, flags)
+    record = write_and_store(result, flags, output, verdict)
     _print(tb, rec, output_units, gravity, fs)
     if output is not None:
         console.print(f"wrote {output}")
-    conclude(console, doc, flags, record, verdict)
+    conclude(console, result, flags, record, verdict)
 
 
 def _print(tb, rec, output_units, gravity: float, fs: float) -> None:

@@ -10,7 +10,7 @@ import typer
 from ..choices import AccelModel, AccelOutputUnit, ImuGyroModel
 from ..constants import STANDARD_GRAVITY
 from ._imu_report import print_imu_run
-from ._options import AcceptImplausible, judge_plausible
+from ._options import AcceptImplausible
 from ._outputs import check_output, same_document
 from ._reading import READING, read_from_flags, required_units
 from ._station import StationFlags, conclude, finish, station_flags, write_and_store
@@ -71,7 +71,6 @@ def imu(
 ) -> None:
     """Calibrate gyro and accelerometer together from still poses and hand turns (no turntable needed)."""
     from ..errors import InputError
-    from ..imu.run import calibrate_recording, implausible
 
     units = required_units(units)
     if accel_units is None:
@@ -91,26 +90,23 @@ def imu(
         rec = attach_accelerometer(rec, accel_log, accel_units=accel_units, columns=accel_columns, skip_rows=skip_rows,
                                    sample_rate=sample_rate, accel_sensitivity=accel_sensitivity, gravity=gravity)
 
-    win = None
-    if windows is not None:
-        from ..io import read_windows
+    from ..jobs import run_job
 
-        win = read_windows(windows, sample_rate=rec.sample_rate, t0=float(rec.t[0]), n_samples=len(rec),
-                           t=rec.t if rec.has_time else None)
-    run = calibrate_recording(rec, windows=win, gravity=gravity, accel_model=accel_model, gyro_model=gyro_model,
-                              g_sensitivity=g_sensitivity, min_static=min_static, output_units=output_units,
-                              accel_output_units=accel_output_units, threshold=threshold)
-    inputs = (recording, windows, accel_log)
-    doc = judge_plausible(run.calibration.to_document(), implausible(run.calibration), accept_implausible)
-    doc, verdict = finish(doc, flags, inputs=inputs)
-    check_output(output, inputs=inputs, force=force, replaceable=same_document(doc),
+    result = run_job("imu", recording=rec, sources=(recording, accel_log), windows=windows, gravity=gravity,
+                     accel_model=accel_model, gyro_model=gyro_model, g_sensitivity=g_sensitivity,
+                     min_static=min_static, output_units=output_units, accel_output_units=accel_output_units,
+                     threshold=threshold, accept_implausible=accept_implausible)
+    if result.implausible is not None:
+        warn(result.implausible)
+    run = result.value
+    result, verdict = finish(result, flags)
+    check_output(output, inputs=result.inputs, force=force, replaceable=same_document(result.document),
                  holds="a different calibration or another file")
     if plot is not None:
         from ..plotting import save_figure
-        from ..plotting.imu import poses_figure
 
-        save_figure(poses_figure(run.result, title=f"{recording.name}: whole-IMU calibration"), plot)
-    record = write_and_store(doc, flags, output, verdict, inputs=inputs, kind="imu", job="imu")
+        save_figure(result.figures["poses"](), plot)
+    record = write_and_store(result, flags, output, verdict)
     for line in run.time_base.describe():
         console.print(line, highlight=False, soft_wrap=True, markup=False)
     print_imu_run(run)
@@ -118,4 +114,4 @@ def imu(
         warn(line)
     if output is not None:
         console.print(f"wrote {output}" + (f" and {plot}" if plot is not None else ""), highlight=False)
-    conclude(console, doc, flags, record, verdict)
+    conclude(console, result, flags, record, verdict)

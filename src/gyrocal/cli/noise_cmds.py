@@ -103,8 +103,7 @@ def noise(
     flags: StationFlags = StationFlags(),
 ) -> None:
     """Allan deviation of a log at rest: noise density, bias instability and random walk, with intervals."""
-    from ..noise import FORMAT, characterise_recording
-    from ..results.files import to_document
+    from ..noise import FORMAT
     from ..units import parse_rate_unit, unit_factor
 
     # every output is checked before anything is read, computed or written
@@ -126,9 +125,11 @@ def noise(
     if rec.accel_units == "counts":
         raise InputError("noise figures are physical quantities, so raw accelerometer counts need their sensitivity",
                          param="accel_sensitivity", hint="give {param} (LSB per g, e.g. 16384 for +-2 g)")
-    report = characterise_recording(rec, motion=motion, source={"file": recording.name})
-    doc, verdict = finish(to_document(report), flags, inputs=(recording,))
-    record = write_and_store(doc, flags, json_out, verdict, inputs=(recording,), kind="noise", job="noise")
+    from ..jobs import run_job
+
+    result, verdict = finish(run_job("noise", recording=rec, sources=(recording,), motion=motion), flags)
+    record = write_and_store(result, flags, json_out, verdict)
+    report = result.value
     shown = parse_rate_unit(output_units or "deg/s") if unit == "counts" else unit
     fs = report.sample_rate
     head = f"{report.duration:.0f} s at {fs:g} Hz, {100 * report.confidence:.0f} % intervals"
@@ -140,8 +141,7 @@ def noise(
         console.print(f"wrote {json_out}")
     if plot is not None:
         from ..plotting import save_figure
-        from ..plotting.noise import allan_figure
 
-        save_figure(allan_figure(report, title=recording.name), plot)
+        save_figure(result.figures["allan"](), plot)
         console.print(f"wrote {plot}")
-    conclude(console, doc, flags, record, verdict)
+    conclude(console, result, flags, record, verdict)

@@ -13,11 +13,11 @@ import typer
 
 from ..choices import OutOfRange
 from ..errors import InputError
-from ._options import AcceptImplausible, in_unit, judge_plausible
+from ._options import AcceptImplausible, in_unit
 from ._outputs import check_output, refuse_swapped, same_document
 from ._reading import READING
 from ._station import StationFlags, conclude, finish, station_flags, write_and_store
-from .app import app, console, warnings_as_lines
+from .app import app, console, warn, warnings_as_lines
 
 __all__ = ["thermal", "thermal_report"]
 
@@ -93,37 +93,27 @@ def thermal(
     flags: StationFlags = StationFlags(),
 ) -> None:
     """Fit a temperature table (the full-temperature-range method) from a turntable session."""
-    from ..thermal import calibrate_thermal
+    from ..jobs import run_job
 
     in_u, out_u = _units(units, output_units, sensitivity)
     check_output(output, inputs=(session,), force=True)  # what needs no fit: fail fast, before fitting
     with warnings_as_lines():
         recs, names = _read(session, units, columns, sample_rate, sensitivity, output_units, skip_rows)
-        cal, fit = calibrate_thermal(recs, input_units=in_u, output_units=out_u, settle=settle,
-                                     full_scale=_full_scale(full_scale, units, out_u, sensitivity),
-                                     temp_tolerance=temp_tolerance, reference_temp=ref_temp, max_order=max_order,
-                                     temp_tau=temp_tau, names=names)
+        result = run_job("thermal", session=recs, names=tuple(names), units=units, input_units=in_u,
+                         output_units=out_u, settle=settle, full_scale=_full_scale(full_scale, units, out_u, sensitivity),
+                         temp_tolerance=temp_tolerance, reference_temp=ref_temp, max_order=max_order,
+                         temp_tau=temp_tau, accept_implausible=accept_implausible)
+    if result.implausible is not None:
+        warn(result.implausible)
+    cal, fit = result.value
     inputs = [session / name for name in names] if session.is_dir() else [session]  # a folder: each file read
-    doc = judge_plausible(cal.to_document(), _implausible(cal), accept_implausible)
-    doc, verdict = finish(doc, flags, inputs=inputs)
-    check_output(output, inputs=(session,), force=force, replaceable=same_document(doc),
+    result, verdict = finish(result, flags, inputs=inputs)
+    check_output(output, inputs=(session,), force=force, replaceable=same_document(result.document),
                  holds="a different calibration or another file")
-    record = write_and_store(doc, flags, output, verdict, inputs=inputs, kind="thermal", job="thermal")
+    record = write_and_store(result, flags, output, verdict, inputs=inputs)
     _print_table(cal, fit)
     console.print(f"wrote {output}")
-    conclude(console, doc, flags, record, verdict)
-
-
-def _implausible(cal) -> str | None:
-    """The plausibility rule on the table's scale factors (1 / Kxx.. at the temperature where they are worst)."""
-    import numpy as np
-
-    from ..checks.plausibility import far_scale
-
-    k = 1.0 / np.abs(cal.kg[:, :3])  # K maps the table's rate to the reading; the scale factor is its inverse
-    worst = int(np.argmax(np.max(np.abs(np.log(k)), axis=1)))
-    text = far_scale(k[worst], cal.input_units, "the table_rate column is not the table's rate about {}")
-    return None if text is None else f"at {cal.temps[worst]:.1f} degC, {text}"
+    conclude(console, result, flags, record, verdict)
 
 
 def _print_table(cal, fit) -> None:

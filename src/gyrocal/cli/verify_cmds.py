@@ -100,30 +100,27 @@ def _print_report(report) -> None:
                   f"{a.n_samples} samples over {a.overlap_s:.1f} s compared", highlight=False, soft_wrap=True)
 
 
-def _write_outputs(folder: Path, report, series, stretch, figures: bool) -> list[Path]:
-    """Write the report's files into `folder`, all or none: each goes to a temporary beside its target
+def _write_outputs(folder: Path, result, stretch, figures: bool) -> list[Path]:
+    """Write the verify job's files into `folder`, all or none: each goes to a temporary beside its target
     and every one moves into place only once all are written. Figures an earlier run left there and this
     run does not draw (``--no-figures``, or no raw readings for before.png) are removed then, so the folder
     never mixes two runs; only gyrocal's own figure names are touched."""
     import contextlib
 
     from .._atomic import atomic_path, write_text_atomic
-    from ..results.files import save
+    from .._jsonfile import write_json
     from ..verify.summary import summary_markdown
 
-    writers = {"verify.json": lambda path: save(report, path),
+    report, series = result.value
+    writers = {"verify.json": lambda path: write_json(path, result.document),
                "summary.md": lambda path: write_text_atomic(path, summary_markdown(report))}
     if figures:  # a stretch outside the logs is refused before anything is written
         from ..plotting import save_figure
-        from ..plotting.verify import check_stretch, error_figure, overlay_figure
+        from ..plotting.verify import check_stretch
 
         check_stretch(series.t, stretch)
-        pictures = {"before.png": lambda: overlay_figure(series, calibrated=False, stretch=stretch),
-                    "after.png": lambda: overlay_figure(series, calibrated=True, stretch=stretch),
-                    "errors.png": lambda: error_figure(series, stretch=stretch)}
-        for name, draw in pictures.items():
-            if name != "before.png" or series.raw is not None:
-                writers[name] = lambda path, draw=draw: save_figure(draw(), path)
+        for name, draw in result.figures.items():  # before (when the raw readings are known), after, errors
+            writers[f"{name}.png"] = lambda path, draw=draw: save_figure(draw(), path)
     folder.mkdir(parents=True, exist_ok=True)
     with contextlib.ExitStack() as stack:
         for name, write in writers.items():
@@ -188,8 +185,8 @@ def verify(
                           "MPU9250, repeating its turns) and its reference log (deg/s, 100 Hz, own clock).")] = False,
 ) -> None:
     """Check a calibration against a reference gyro that recorded the same motion (two clocks, two mounts)."""
+    from ..jobs import run_job
     from ..results.files import load_correction
-    from ..verify import verify_calibration
 
     if example:
         test, reference = _example(test, reference)
@@ -212,11 +209,11 @@ def verify(
                           ref_topic, ref_saturation, ref_no_unit_check)
     options = {name: value for name, value in (("model", model), ("out_of_range", out_of_range)) if given(ctx, name)}
     inputs = {"calibration": calibration.name, "test": test.name, "reference": reference.name}
-    report, series = verify_calibration(cal, rec, ref, seed=seed, fit_drift=not no_drift, replicates=replicates,
-                                        inputs=inputs, **options)
-    written = _write_outputs(output, report, series, span, figures)
-    _print_report(report)
-    for line in report.warnings:
+    result = run_job("verify", calibration=cal, test=rec, reference=ref, seed=seed, fit_drift=not no_drift,
+                     replicates=replicates, names=inputs, apply_options=options, stretch=span)
+    written = _write_outputs(output, result, span, figures)
+    _print_report(result.value[0])
+    for line in result.warnings:
         warn(line)
     console.print("wrote " + ", ".join(str(p) for p in written), highlight=False, soft_wrap=True)
 

@@ -18,7 +18,8 @@ from .identity import check_serial
 
 __all__ = ["IDENTITY_COLUMNS", "JOBS", "Row", "read_manifest"]
 
-#: Job -> the flag its result file is written with.
+#: Job (a name of :data:`gyrocal.jobs.JOBS` whose command takes the station's flags) -> the flag its result
+#: file is written with.
 JOBS = {"calibrate": "-o", "imu": "-o", "thermal": "-o", "thermal-bias": "-o", "noise": "-o"}
 REQUIRED = ("file", "serial", "job", "args")
 IDENTITY_COLUMNS = ("part", "revision", "station", "operator", "fixture", "procedure")
