@@ -64,6 +64,21 @@ printf '   total      %5d\n' "$total"
 echo "== whole example image (library, example, start-up):"
 arm-none-eabi-size "$build/example.elf"
 
+echo "== the whole-IMU temperature table (gyrocal_imu_thermal_correct with the GYROCAL_IMU_THERMAL of tools/m4/imu_thermal_cal.h):"
+echo "   flash (text and const data) in the example image, bytes:"
+imu_flash=0
+while read -r addr size type name; do
+    case "$name" in gyrocal_imu_thermal_correct|gyrocal_poly_correct|finite3|GYROCAL_IMU_THERMAL)
+        where="flash"
+        [ $((16#$addr)) -lt $((16#20000000)) ] || where="RAM"
+        printf '   %-30s %5d  (%s, in %s)\n' "$name" $((16#$size)) "$type" "$where"
+        imu_flash=$((imu_flash + 16#$size)) ;;
+    esac
+done < <(arm-none-eabi-nm -S "$build/example.elf")
+printf '   total                          %5d\n' "$imu_flash"
+imu_ram="$(arm-none-eabi-size -A "$build/gyrocal_cal.o" | awk '$1 ~ /^\.(data|bss)/ { s += $2 } END { print s + 0 }')"
+echo "   static RAM: library data + bss $imu_ram B (the table is const, in flash; outputs on the caller's stack)"
+
 echo "== static stack use per function (-fstack-usage), bytes:"
 awk -F'\t' '{ sub(/^.*:/, "", $1); printf "   %-30s %5s  %s\n", $1, $2, $3 }' "$build/gyrocal_cal.su"
 
@@ -103,6 +118,7 @@ awk '
         label[1] = "gyrocal_accum_add, one sample"; label[2] = "gyrocal_algorithm1, six observations"
         label[3] = "gyrocal_first_moment, six observations"; label[4] = "gyrocal_correct, one sample"
         label[5] = "gyrocal_thermal_correct, one sample"
+        label[6] = "gyrocal_imu_thermal_correct, one sample"
         print "== executed instructions (QEMU trace, one instruction per block):"
         for (i = 1; i <= k; i++) printf "   %-40s %7d\n", label[i], counts[i]
     }' "$fifo" &
@@ -113,7 +129,9 @@ rm -f "$fifo"
 echo "== the example firmware (examples/firmware) on the emulated M4: frames from the six-turn session"
 ex="$root/examples/firmware"
 arm-none-eabi-gcc "${CFLAGS[@]}" -I"$csrc" -I"$ex" -I"$m4" -c "$ex/gyrocal_example.c" -o "$build/gyrocal_example.o"
-arm-none-eabi-gcc "${CFLAGS[@]}" -I"$csrc" -I"$ex" -I"$m4" -c "$ex/qemu_board.c" -o "$build/qemu_board.o"
+# The board layer's byte copies (board_store, board_load) must not become calls to memcpy: there is no libc.
+arm-none-eabi-gcc "${CFLAGS[@]}" -fno-tree-loop-distribute-patterns -I"$csrc" -I"$ex" -I"$m4" -c "$ex/qemu_board.c" \
+    -o "$build/qemu_board.o"
 arm-none-eabi-gcc "${CFLAGS[@]}" -nostdlib -nostartfiles -T "$m4/mps2_an386.ld" -Wl,--gc-sections \
     "$build/startup.o" "$build/qemu_board.o" "$build/gyrocal_example.o" "$build/gyrocal_session.o" \
     "$build/gyrocal_frame.o" "$build/gyrocal_cal.o" -lgcc -o "$build/firmware.elf"

@@ -1,13 +1,20 @@
 /*
  * On-device example for QEMU mps2-an386 (Cortex-M4F): stream six simulated 360 deg turns through the
  * window accumulator, calibrate with Algorithm 1 and with the first-moment estimator, correct a sample
- * and apply a thermal table. Each library call sits between marker_begin() and marker_end(), which
- * tools/cross_m4.sh finds in QEMU's instruction trace to count executed instructions; the stack
+ * and apply a thermal table; then correct one still IMU sample (gyro and accelerometer) with the whole-IMU
+ * temperature table of imu_thermal_cal.h. Each library call sits between marker_begin() and marker_end(),
+ * which tools/cross_m4.sh finds in QEMU's instruction trace to count executed instructions; the stack
  * below each call is painted first, to measure its peak use.
+ *
+ * imu_thermal_cal.h is the unedited output of gyrocal for a simulated chamber session (seed 0), made by
+ *   gyrocal simulate --protocol multi-position --temp-points -25,0,25,50 -o chamber.csv
+ *   gyrocal imu chamber.csv --units deg/s --accel-units m/s^2 -o cal.json
+ *   gyrocal export cal.json --format c-header -o tools/m4/imu_thermal_cal.h
  */
 #include <stdint.h>
 
 #include "gyrocal_cal.h"
+#include "imu_thermal_cal.h"
 #include "semihost.h"
 
 #define FS 200.0f           /* sample rate [Hz] */
@@ -174,6 +181,40 @@ static const float T_KG[5][12] = {
     {0.993f, 1.007f, 1.003f, 0.001f, -0.002f, 0.003f, 0.001f, -0.001f, 0.002f, 0.003f, -0.002f, 0.001f},
 };
 
+/* One still sample of chamber.csv at 25 degC (its first at that plateau, board level): gyro converted from
+ * deg/s to rad/s (the table's gyro input units), accelerometer in m/s^2. */
+#define IMU_TEMP 25.0f
+static const float IMU_GYRO_RAW[3] = {0.304058667f * 0.0174532925f, -3.11546143f * 0.0174532925f,
+                                      -2.90567856f * 0.0174532925f};
+static const float IMU_ACCEL_RAW[3] = {0.152001582f, -0.0686048951f, 10.0401464f};
+
+/* Correct the sample with GYROCAL_IMU_THERMAL; ok when the corrected specific force has gravity's magnitude
+ * (within 0.1 m/s^2: one sample's accelerometer noise is 0.02 m/s^2 per axis) and the corrected rate is
+ * near zero (within 0.2 rad/s: 0.035 rad/s of noise per axis). */
+static int imu_thermal_example(void)
+{
+    float w[3], a[3], a2 = 0.0f, w2 = 0.0f;
+    uint32_t sp0;
+    int st;
+    (void)GYROCAL_CALIBRATION; /* the header's other tables: not used here */
+    (void)GYROCAL_IMU;
+    PAINT_STACK(sp0);
+    marker_begin();
+    st = gyrocal_imu_thermal_correct(&GYROCAL_IMU_THERMAL, IMU_TEMP, IMU_GYRO_RAW, IMU_ACCEL_RAW, w, a);
+    marker_end();
+    report("gyrocal_imu_thermal_correct", stack_used(sp0));
+    sh_puts("imu_thermal_correct: status ");
+    put_u((uint32_t)st);
+    sh_puts("\n");
+    put_vec("  w [rad/s] (still sample, 25 degC)", w);
+    put_vec("  a [m/s^2] (still sample, 25 degC)", a);
+    for (int i = 0; i < 3; ++i) {
+        a2 += a[i] * a[i];
+        w2 += w[i] * w[i];
+    }
+    return st == GYROCAL_OK && a2 > 9.70665f * 9.70665f && a2 < 9.90665f * 9.90665f && w2 < 0.04f;
+}
+
 int main(void)
 {
     static gyrocal_obs_t obs[GYROCAL_N_OBS];
@@ -238,6 +279,7 @@ int main(void)
     ok = check("first_moment", &fm, st2, it2) && ok;
     ok = ok && st3 == GYROCAL_OK;
     put_vec("thermal_correct(+x turn mean, 27.5 degC)", w);
+    ok = imu_thermal_example() && ok;
     sh_puts(ok ? "RESULT OK\n" : "RESULT FAILED\n");
     return ok ? 0 : 1;
 }
