@@ -29,3 +29,10 @@ def refused(*args) -> str:
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error:"), err
     return lines[0]
+
+
+def simulated(path, *args):
+    """`gyrocal simulate -o path ARGS`, asserted to succeed; returns `path`."""
+    code, _, err = invoke("simulate", "-o", path, *args)
+    assert code == 0, err
+    return path

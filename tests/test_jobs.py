@@ -18,7 +18,7 @@ import subprocess
 import sys
 
 import pytest
-from cli_runner import invoke
+from cli_runner import invoke, simulated
 from thermal_sessions import thermal_session
 
 from gyrocal.errors import InputError
@@ -28,22 +28,16 @@ from gyrocal.jobs.result import JobResult, same_document
 DATA = pathlib.Path(__file__).resolve().parents[1] / "src" / "gyrocal" / "data"
 
 
-def _simulate(path, *args):
-    code, _, err = invoke("simulate", "-o", path, *args)
-    assert code == 0, err
-    return path
-
-
 @pytest.fixture(scope="module")
 def cases(tmp_path_factory):
     """Job name -> (its options, the CLI command line that writes the same result, the file it writes)."""
     d = tmp_path_factory.mktemp("jobs")
-    servo = _simulate(d / "servo.csv", "--seed", "11")
-    hand = _simulate(d / "hand.csv", "--protocol", "multi-position", "--poses", "12", "--still", "2",
+    servo = simulated(d / "servo.csv", "--seed", "11")
+    hand = simulated(d / "hand.csv", "--protocol", "multi-position", "--poses", "12", "--still", "2",
                      "--sample-rate", "50", "--noise", "0.002", "--k", "1.01,0.99,1.02", "--seed", "5")
-    rest = _simulate(d / "rest.csv", "--protocol", "static", "--duration", "120", "--sample-rate", "50",
+    rest = simulated(d / "rest.csv", "--protocol", "static", "--duration", "120", "--sample-rate", "50",
                      "--noise", "0.005", "--units", "rad/s", "--seed", "5")
-    warm = _simulate(d / "warm.csv", "--protocol", "static", "--duration", "600", "--sample-rate", "10",
+    warm = simulated(d / "warm.csv", "--protocol", "static", "--duration", "600", "--sample-rate", "10",
                      "--noise", "0.005", "--temp-start", "-5", "--temp-end", "50", "--warmup-tau", "150",
                      "--temp-quantum", "1", "--bias-tempco", "2e-4,-1e-4,5e-5;-3e-6,0,2e-6;5e-8,0,0", "--seed", "3")
     session = thermal_session(d / "thermal.csv")

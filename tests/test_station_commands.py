@@ -16,7 +16,7 @@ import json
 import math
 
 import pytest
-from cli_runner import invoke, refused
+from cli_runner import invoke, refused, simulated
 from thermal_sessions import thermal_session
 
 from gyrocal.store import open_store
@@ -28,21 +28,15 @@ def _sha(path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
-def _simulate(path, *args):
-    code, _, err = invoke("simulate", "-o", path, *args)
-    assert code == 0, err
-    return path
-
-
 @pytest.fixture(scope="module")
 def inputs(tmp_path_factory):
     d = tmp_path_factory.mktemp("station")
     return {
-        "imu": _simulate(d / "hand.csv", "--protocol", "multi-position", "--poses", "12", "--still", "2",
+        "imu": simulated(d / "hand.csv", "--protocol", "multi-position", "--poses", "12", "--still", "2",
                          "--sample-rate", "50", "--noise", "0.002", "--k", "1.01,0.99,1.02", "--seed", "5"),
-        "noise": _simulate(d / "rest.csv", "--protocol", "static", "--duration", "300", "--sample-rate", "50",
+        "noise": simulated(d / "rest.csv", "--protocol", "static", "--duration", "300", "--sample-rate", "50",
                            "--noise", "0.005", "--units", "rad/s", "--seed", "5"),
-        "thermal-bias": _simulate(d / "warm.csv", "--protocol", "static", "--duration", "1200", "--sample-rate",
+        "thermal-bias": simulated(d / "warm.csv", "--protocol", "static", "--duration", "1200", "--sample-rate",
                                   "20", "--noise", "0.005", "--temp-start", "-5", "--temp-end", "50",
                                   "--warmup-tau", "300", "--temp-quantum", "1", "--bias-tempco",
                                   "2e-4,-1e-4,5e-5;-3e-6,0,2e-6;5e-8,0,0", "--seed", "3"),
