@@ -121,11 +121,11 @@ def _check_steps(rec, run, windows, fit) -> None:
     their refits, plausibility, the file's sections."""
     from gyrocal.checks.fit import check_fit
     from gyrocal.checks.plausibility import Context
-    from gyrocal.checks.screening import screen_gaps
     from gyrocal.estimators import make_estimator
     from gyrocal.observations.turn_angle import follow_wander
     from gyrocal.pipeline import _observed
     from gyrocal.results.sections import FitQuality, Observed
+    from gyrocal.segmentation.screening import screen_gaps
 
     tb = rec.time_base()
     screen_gaps(run.segmentation, rec, tb, run.reference, tb.clock_times() if tb.gaps else None)

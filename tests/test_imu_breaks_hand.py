@@ -160,8 +160,8 @@ def test_the_threshold_override_is_used_and_said(tmp_path):
 
 
 def test_calibrate_leaves_out_turns_across_a_break_and_cuts_static_windows():
-    from gyrocal.checks.screening import screen_breaks
     from gyrocal.segmentation import Segmentation
+    from gyrocal.segmentation.screening import screen_breaks
     from gyrocal.segmentation.windows import Window
 
     seg = Segmentation(windows=(Window(0, 100, "static"), Window(100, 200, "rotation", "z", 1), Window(200, 300, "static")))

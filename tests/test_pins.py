@@ -10,7 +10,6 @@ from scipy.stats import t as student_t
 
 from gyrocal import units
 from gyrocal.checks import excess
-from gyrocal.checks.screening import screen_gaps
 from gyrocal.estimators import FirstMoment
 from gyrocal.flight.polyfit import choose_orders
 from gyrocal.models import ScaleBias
@@ -19,6 +18,7 @@ from gyrocal.observations import ObservationSet
 from gyrocal.pipeline import calibrate
 from gyrocal.recording import Recording
 from gyrocal.segmentation import Segmentation
+from gyrocal.segmentation.screening import screen_gaps
 from gyrocal.segmentation.windows import Window
 from gyrocal.simulation import VirtualGyro
 from gyrocal.simulation.servo import ServoProtocol, simulate_servo
@@ -103,7 +103,7 @@ def test_flagged_paper_fit_has_covariance_times_chi2_per_dof():
         np.testing.assert_allclose(run.fit.covariance, plain.fit.covariance * chi2_per_dof + earth, rtol=1e-8)
 
 
-# --- the gap bound of gyrocal.checks.screening ---
+# --- the gap bound of gyrocal.segmentation.screening ---
 
 
 def test_hidden_gap_of_known_bound_gives_the_uniform_variance():

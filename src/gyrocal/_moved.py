@@ -28,7 +28,7 @@ MOVED = {
     "gyrocal.observed": "gyrocal.observations.observed",
     "gyrocal.turn_angle": "gyrocal.observations.turn_angle",
     "gyrocal.excess": "gyrocal.checks.excess",
-    "gyrocal.screening": "gyrocal.checks.screening",
+    "gyrocal.screening": "gyrocal.segmentation.screening",
     "gyrocal.fit_checks": "gyrocal.checks.fit",
     "gyrocal.quality": "gyrocal.checks.quality",
     "gyrocal.plausibility": "gyrocal.checks.plausibility",

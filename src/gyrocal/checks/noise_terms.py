@@ -22,17 +22,10 @@ import numpy as np
 
 from ..estimators import FitResult
 
-__all__ = ["EARTH_RATE", "sigma_covers", "white_floor", "with_earth_rate", "noise_notes"]
+__all__ = ["EARTH_RATE", "sigma_covers", "with_earth_rate", "noise_notes"]
 
 EARTH_RATE = 7.2921159e-5  # [rad/s] the Earth's rotation rate (sidereal)
 _EARTH_SD = EARTH_RATE / math.sqrt(3.0)  # its projection on an axis of unknown orientation
-
-
-def white_floor(observations, noise_std) -> tuple:
-    """`observations` whose measured mean variances are at least the given white noise's, ``noise_std^2 / n``."""
-    var = np.broadcast_to(np.square(np.asarray(noise_std, dtype=float)), (3,))
-    return tuple(o if o.mean_var is None else dataclasses.replace(o, mean_var=np.maximum(o.mean_var, var / o.count))
-                 for o in observations)
 
 
 def with_earth_rate(fit: FitResult) -> FitResult:

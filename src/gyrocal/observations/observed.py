@@ -21,7 +21,7 @@ import numpy as np
 from ..errors import UnitError
 from ..units import unit_factor
 
-__all__ = ["QUIET_BLOCK", "quiet_noise", "observe", "check_observed"]
+__all__ = ["QUIET_BLOCK", "quiet_noise", "observe", "observed_section", "check_observed"]
 
 #: Length of the blocks whose standard deviations give the noise level [s].
 QUIET_BLOCK = 0.5
@@ -49,6 +49,23 @@ def quiet_noise(raw: np.ndarray, sample_rate: float) -> np.ndarray:
     var = np.stack([cut[:, j].reshape(blocks, size).var(axis=1, ddof=1) for j in range(raw.shape[1])], axis=1)
     quiet = var <= (1.5 * np.sqrt(np.percentile(var, 10, axis=0))) ** 2
     return np.sqrt(np.sum(np.where(quiet, var, 0.0), axis=0) / np.sum(quiet, axis=0))
+
+
+def observed_section(rec, tb, input_scale: float, input_units: str, quiet_sample: np.ndarray) -> dict:
+    """What a calibration saw (the file's ``observed`` section), rates in the input units.
+
+    `input_scale` is internal units per input unit; `quiet_sample` the readings the quiet noise is measured
+    on (spread blocks of the recording). ``noise_std``, the noise behind the fit, is left as None for the
+    result to fill.
+    """
+    # up to 20 000 evenly spread samples (every 50 ms at 1 kHz: a turn's rate lasts longer); the order of
+    # magnitude is what a unit check needs
+    sample = np.ascontiguousarray(rec.gyro[:: max(1, len(rec) // 20_000)].T)  # one row per axis, one pass
+    peak = np.maximum(sample.max(axis=1), -sample.min(axis=1))
+    return {"sample_rate": rec.sample_rate, "units": input_units, "noise_std": None,
+            "max_abs_rate": (peak / input_scale).tolist(), "time_base": tb.to_document(),
+            # the noise of the quiet stretches, measured as apply measures the data it corrects
+            "quiet_noise_std": (quiet_noise(quiet_sample, rec.sample_rate) / input_scale).tolist()}
 
 
 def observe(raw: np.ndarray, sample_rate: float, units: str) -> dict:

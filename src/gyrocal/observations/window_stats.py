@@ -24,6 +24,7 @@ same variance of the mean, a fifth of the work at 1 kHz.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 
 import numpy as np
@@ -34,7 +35,7 @@ from . import Observation, observe_many
 from .longrun import block_means, find_lines, fit_levels, newey_west_var, span_variance
 from .partial_cycles import partial_cycles, weigh_readings
 
-__all__ = ["observe_windows"]
+__all__ = ["observe_windows", "white_floor"]
 
 _STATS_RATE = 200.0  # [Hz] rate of the block means behind the plateau and static statistics
 
@@ -178,3 +179,10 @@ def _plateau_stats(gyro: np.ndarray, blocks: dict, span: dict, plateaus: list[in
             out.setdefault(i, {})["mean_var"] = b * fits[i][1] + a * fits[i][1] ** 2
     return out
 
+
+
+def white_floor(observations, noise_std) -> tuple:
+    """`observations` whose measured mean variances are at least the given white noise's, ``noise_std^2 / n``."""
+    var = np.broadcast_to(np.square(np.asarray(noise_std, dtype=float)), (3,))
+    return tuple(o if o.mean_var is None else dataclasses.replace(o, mean_var=np.maximum(o.mean_var, var / o.count))
+                 for o in observations)

@@ -26,19 +26,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks.noise_terms import sigma_covers, white_floor
 from ..checks.quality import GoodnessOfFit
-from ..checks.screening import reference_variances
 from ..estimators import FitResult
 from ..observations import Observation
-from ..observations.observed import quiet_noise
-from ..observations.window_stats import observe_windows
+from ..observations.observed import observed_section
+from ..observations.window_stats import observe_windows, white_floor
 from ..recording import Recording
 from ..recording.timebase import TimeBase
-from ..results.calibration import Calibration
+from ..results.calibration import Calibration, used_windows
 from ..segmentation import Segmentation
 from ..segmentation.windows import Window
-from ..units import unit_factor
+from ..units import input_scale, unit_factor
 from . import stages
 
 __all__ = ["CalibrationRun", "calibrate", "observations", "parameter_rows", "result"]
@@ -240,77 +238,64 @@ def calibrate(
     reference, value, first_moment = req.reference, req.value, method == "first-moment"
     seg = stages.windows(rec, reference, value, windows, screen=checks)
     clock = stages.time_base(rec, read=checks)
-    use = stages.usable(seg, rec, clock, reference, method, refuse_varying=checks and not first_moment)
-    obs = observations(rec, use, reference, value, clock, long_run=long_run and first_moment,
-                        noise_std=noise_std, turn_sd=reference_sd if reference == "angle" else None)
-    obs, obs_set, fit = stages.fit(rec, clock, use.windows, obs, req.estimator,
-                                   wander=checks and first_moment and reference == "angle")
-    checked = stages.Checked(fit)
+    use = stages.usable(seg, rec, clock, reference, value, method, refuse_varying=checks and not first_moment,
+                        turn_sd=reference_sd if reference == "angle" else None)
+    obs, seen = observations(rec, use, reference, value, clock, long_run=long_run and first_moment,
+                             noise_std=noise_std, observed=checks, input_units=req.input_units,
+                             output_units=req.output_units)
+    fitted = stages.fit(rec, clock, use.windows, obs, req, wander=checks and first_moment and reference == "angle")
+    checked = stages.Checked(fitted.result)
     if checks:
-        checked = stages.check(fit, obs_set, obs, req.estimator, rec, use, clock, req,
-                               declared=windows is None or reference == "speed", noise_given=noise_std is not None,
-                               reference_sd=reference_sd)
+        checked = stages.check(fitted, rec, use, clock, req, declared=windows is None or reference == "speed",
+                               noise_given=noise_std is not None, reference_sd=reference_sd)
     fit = stages.uncertainty(checked.fit, earth_rate=checks,
                              speed_rel_sd=reference_sd / value if reference == "speed" and reference_sd else None)
-    return result(rec, req, method, use, obs, fit, checked, clock.base, noise_given=noise_std is not None)
+    return result(rec, req, use, fitted.observations, fit, checked, clock.base, seen)
 
 
 def observations(rec: Recording, use: stages.Usable, reference: str, value: float, clock: stages.Clock, *,
-                 long_run: bool, noise_std, turn_sd: float | None) -> tuple[Observation, ...]:
-    """Owns reducing each window to an observation: its mean reading and reference rate with variances.
+                 long_run: bool, noise_std, observed: bool, input_units: str, output_units: str
+                 ) -> tuple[tuple[Observation, ...], dict | None]:
+    """Owns reducing the recording: each window to an observation (its mean reading and reference rate with
+    variances) and, `observed`, what the data looked like (the file's ``observed`` section, less the noise
+    behind the fit, which the result adds).
 
     `long_run`: ripple regressed out and mean variances from the long-run variance (else white);
-    `noise_std`: a floor on the white level; `turn_sd`: each turn's declared angle accuracy [rad].
+    `noise_std`: a floor on the white level.
     """
     obs = observe_windows(rec, use.windows, reference, value, long_run=long_run, ripple=long_run,
                           times=clock.times, period=clock.period)
     if noise_std is not None:  # the given white level is a floor; the data's long-run correlation still counts
         obs = white_floor(obs, noise_std)
     # turns across a time-stamp gap (their rate known within its bound), and each turn's declared accuracy
-    rel_var = reference_variances(use.windows, reference, value, turn_sd, use.angle_var)
-    return tuple(dataclasses.replace(o, rate_var=v * o.rate**2) if v else o for v, o in zip(rel_var, obs))
+    obs = tuple(dataclasses.replace(o, rate_var=v * o.rate**2) if v else o for v, o in zip(use.rate_rel_var, obs))
+    if not observed:
+        return obs, None
+    scale = input_scale(input_units, rec.sensitivity if input_units == "counts" else None, output_units)
+    return obs, observed_section(rec, clock.base, scale, input_units, _spread_blocks(rec.gyro, rec.sample_rate))
 
 
-def result(rec: Recording, req: stages.Request, method: str, use: stages.Usable, obs: tuple[Observation, ...],
-           fit: FitResult, checked: stages.Checked, tb: TimeBase | None, *, noise_given: bool) -> CalibrationRun:
+def result(rec: Recording, req: stages.Request, use: stages.Usable, obs: tuple[Observation, ...], fit: FitResult,
+           checked: stages.Checked, tb: TimeBase | None, seen: dict | None) -> CalibrationRun:
     """Owns the run's result: the calibration in user units with the windows used, and, when checked
-    (`checked.quality` not None), the file's ``fit`` and ``observed`` sections."""
+    (`checked.section` not None), the file's ``fit`` and ``observed`` sections (built once: freezing thousands
+    of residuals costs)."""
     input_units = req.input_units
     cal = Calibration(
         model=fit.model,
         input_units=input_units,
         output_units=req.output_units,
         sensitivity=rec.sensitivity if input_units == "counts" else None,
-        method=method,
+        method=req.method,
         covariance=fit.covariance,
         noise_std=fit.noise_std,
-        windows=tuple({**w.to_dict(), "rate": o.rate} for w, o in zip(use.windows, obs)),
+        windows=used_windows(use.windows, [o.rate for o in obs]),
     )
-    if checked.quality is not None:  # the file's sections, built once (freezing thousands of residuals costs)
-        # every warning and note printed goes in the file too: a flagged calibration must not look clean there
-        cal = dataclasses.replace(cal, fit={**checked.quality.to_document(), "warnings": list(checked.warnings),
-                                            "notes": list(checked.notes),
-                                            "sigma_covers": sigma_covers(obs, req.reference, noise_given)},
-                                  observed=_observed(rec, tb, fit.noise_std, cal.input_scale, input_units))
+    if checked.section is not None:
+        seen = {**seen, "noise_std": (np.asarray(fit.noise_std, dtype=float) / cal.input_scale).tolist()}
+        cal = dataclasses.replace(cal, fit=checked.section, observed=seen)
     return CalibrationRun(cal, fit, use.segmentation, obs, req.reference, req.value, checked.quality, tb,
                           checked.warnings, checked.notes, checked.implausible)
-
-
-def _observed(rec: Recording, tb: TimeBase, noise_std, input_scale: float, input_units: str) -> dict:
-    """What the calibration saw (the file's ``observed`` section), rates in the input units.
-
-    `input_scale` is internal units per input unit (:attr:`gyrocal.results.calibration.Calibration.input_scale`).
-    """
-    # up to 20 000 evenly spread samples (every 50 ms at 1 kHz: a turn's rate lasts longer); the order of
-    # magnitude is what a unit check needs
-    sample = np.ascontiguousarray(rec.gyro[:: max(1, len(rec) // 20_000)].T)  # one row per axis, one pass
-    peak = np.maximum(sample.max(axis=1), -sample.min(axis=1))
-    return {"sample_rate": rec.sample_rate, "units": input_units,
-            "noise_std": (np.asarray(noise_std, dtype=float) / input_scale).tolist(),
-            "max_abs_rate": (peak / input_scale).tolist(), "time_base": tb.to_document(),
-            # the noise of the quiet stretches, measured as apply measures the data it corrects
-            "quiet_noise_std": (quiet_noise(_spread_blocks(rec.gyro, rec.sample_rate), rec.sample_rate)
-                                / input_scale).tolist()}
 
 
 def _spread_blocks(gyro: np.ndarray, sample_rate: float, most: int = 200) -> np.ndarray:

@@ -43,7 +43,7 @@ from ..recording import Recording
 from ..units import InputUnit, RateUnit, input_scale, parse_input_unit, parse_rate_unit, unit_factor
 from .sections import AccelerometerPart, FitQuality, Observed, section
 
-__all__ = ["Calibration"]
+__all__ = ["Calibration", "used_windows"]
 
 #: Key of each model's parameters in the document.
 _PARAMETERS_KEY = {"scale-bias": "scale_bias", "affine": "affine"}
@@ -274,6 +274,11 @@ class Calibration:
             raise FileFormatError(f"{path}: field 'units': {exc}", "units") from None
         _check_correction(doc, cal, path)
         return cal
+
+
+def used_windows(windows, rates) -> tuple[dict, ...]:
+    """The windows a fit used, as the file records them: each window's own fields and its reference rate."""
+    return tuple({**w.to_dict(), "rate": rate} for w, rate in zip(windows, rates))
 
 
 def _model_from_document(doc: dict, path) -> CalibrationModel:

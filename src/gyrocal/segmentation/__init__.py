@@ -1,7 +1,8 @@
 """Automatic segmentation of calibration sessions into rotation and static windows.
 
-Owns the :class:`~.windows.Window` type (:mod:`.windows`), detection and given windows, and
-whether a log is still (:mod:`.stillness`).
+Owns the :class:`~.windows.Window` type (:mod:`.windows`), detection and given windows, the windows a
+method must not use as they are (:mod:`.screening`: across a gap or a break, varying rates for the paper's
+methods) and whether a log is still (:mod:`.stillness`).
 
 Layer 2 (windows) of docs/architecture.md: imports the package root and layers 1 to 2 only.
 """

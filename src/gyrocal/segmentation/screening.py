@@ -26,8 +26,8 @@ from ..errors import InputError
 from ..recording import Recording
 from ..recording.breaks import spans_break, split_spans
 from ..recording.timebase import Gap, TimeBase
-from ..segmentation import Segmentation
-from ..segmentation.windows import Window
+from ._result import Segmentation
+from .windows import Window
 
 __all__ = ["MAX_GAP_SHARE", "MAX_RATE_CV", "rate_variation", "reference_variances", "require_constant_rate",
            "screen_breaks", "screen_gaps"]
