@@ -89,6 +89,15 @@ class TemperatureModel:
             raise InputError(f"scheme must be one of {', '.join(SCHEMES)}, got {scheme!r}")
         return self.smooth_at(temp) if scheme == "smooth" else self.lagrange_at(temp)
 
+    def with_constant_variance(self, variance) -> "TemperatureModel":
+        """This model with `variance` (m,) added to each parameter's constant coefficient: a variance at every
+        temperature alike (an error the points share, such as half a hysteresis)."""
+        m, width = len(self.names), self.smooth.coefs.shape[1]
+        idx = np.arange(m) * width
+        cov = self.smooth_covariance.copy()
+        cov[idx, idx] += np.asarray(variance, dtype=float)
+        return replace(self, smooth_covariance=cov)
+
     def to_dict(self) -> dict:
         """The file's form: points, the smooth model with its coefficients' covariance, the misfit."""
         return {
