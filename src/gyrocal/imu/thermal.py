@@ -31,7 +31,7 @@ from ._gyro_solve import MASKS
 from .accel import model_matrices
 from .plateaus import Plateau, find_plateaus, temperature_points
 from .session import ImuCalibrationResult, calibrate_imu
-from .thermal_limits import Limits, assess, branches, too_few_poses
+from .thermal_limits import Limits, assess, branches, lag_corrected, too_few_poses
 from .thermal_model import TemperatureModel, temperature_model
 
 __all__ = ["FRAME", "ImuPoint", "ImuThermalResult", "calibrate_imu_thermal", "correct_with_section", "sensor_matrices"]
@@ -178,7 +178,8 @@ def _point(group: list[tuple[Plateau, ImuCalibrationResult]], sides: list[str], 
 
 def calibrate_imu_thermal(t, gyro, accel, temp, *, gravity: float = STANDARD_GRAVITY, accel_model="auto",
                           gyro_model="auto", min_static: float = 1.0, gaps=(), breaks=(), threshold=None,
-                          tol: float = 1.0, min_plateau: float = 30.0, max_order: int = 3) -> ImuThermalResult:
+                          tol: float = 1.0, min_plateau: float = 30.0, max_order: int = 3,
+                          sensor_lag: float | None = None) -> ImuThermalResult:
     """Calibrate both sensors at each temperature point of a chamber log and model them in temperature.
 
     Parameters
@@ -191,6 +192,8 @@ def calibrate_imu_thermal(t, gyro, accel, temp, *, gravity: float = STANDARD_GRA
         See :func:`~gyrocal.imu.plateaus.find_plateaus` [degC, s].
     max_order : int
         Highest order of the smooth polynomial tried.
+    sensor_lag : float, optional
+        Time constant [s] of a temperature sensor that lags the die (:func:`~gyrocal.imu.thermal_limits.lag_corrected`).
 
     Raises
     ------
@@ -201,7 +204,9 @@ def calibrate_imu_thermal(t, gyro, accel, temp, *, gravity: float = STANDARD_GRA
     kw = {"gravity": gravity, "accel_model": accel_model, "gyro_model": gyro_model, "min_static": min_static,
           "threshold": threshold}
     fitted, notes = [], []
-    for plateau in find_plateaus(t, temp, breaks=breaks, tol=tol, min_duration=min_plateau):
+    temp = np.asarray(temp, dtype=float)
+    for plateau in lag_corrected(t, temp, find_plateaus(t, temp, breaks=breaks, tol=tol, min_duration=min_plateau),
+                                 sensor_lag):
         try:
             fitted.append((plateau, _fit_plateau(t, gyro, accel, plateau, gaps, kw)))
         except (DegenerateDesignError, SegmentationError) as exc:
@@ -216,7 +221,7 @@ def calibrate_imu_thermal(t, gyro, accel, temp, *, gravity: float = STANDARD_GRA
     fitted, am, gm = _harmonise(t, gyro, accel, fitted, gaps, kw, accel_model, gyro_model)
     groups = temperature_points([p for p, _ in fitted], tol)
     k = int(MASKS[gm].sum()) + 3
-    limits = assess(t, np.asarray(temp, dtype=float), fitted, groups, k, tol)
+    limits = assess(t, temp, fitted, groups, k, tol, sensor_lag)
     sides = branches([p for p, _ in fitted], tol)
     points = tuple(_point([fitted[i] for i in g], [sides[i] for i in g], limits) for g in groups)
     if len(points) < 3:

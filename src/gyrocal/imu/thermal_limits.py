@@ -17,13 +17,15 @@ A lagging temperature sensor. While the die follows the chamber, a sensor that l
 during a plateau's poses. Each plateau's temperature drift is the slope of a straight line through
 its readings (white reading noise: the slope's standard error from the residuals) times its length;
 a drift beyond :data:`DRIFT_LIMIT` and beyond :data:`DRIFT_Z` times its 1-sigma is flagged. The
-reading then trails the die by about ``tau`` times the slope, which the plateau alone cannot give:
-the flag says so and the point's temperature is not corrected.
+reading then trails the die by ``tau`` times the slope (``y - T_die = -tau y'`` for a first-order lag), and
+``tau`` is not measurable from a plateau much shorter than it (the curvature ``y'' = -y' / tau`` is below the
+reading noise): the flag says so, and with ``tau`` known (a datasheet, a step test) :func:`lag_corrected`
+moves each plateau's temperature to the die's, ``mean + tau * slope``.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -31,12 +33,13 @@ from .._chi2 import chi2_sf
 from .plateaus import Plateau
 
 __all__ = ["DRIFT_LIMIT", "DRIFT_Z", "HYSTERESIS_P", "Drift", "Hysteresis", "Limits", "assess", "branches",
-           "hysteresis", "plateau_drift", "too_few_poses"]
+           "hysteresis", "lag_corrected", "plateau_drift", "too_few_poses"]
 
 #: Branches whose difference has a chi-square p-value below this are flagged as hysteresis.
 HYSTERESIS_P = 1e-3
-#: A plateau whose temperature moves more than this over its poses is flagged [degC] ...
-DRIFT_LIMIT = 0.2
+#: A plateau whose temperature moves more than this over its poses is flagged [degC] (a lag ``tau`` much
+#: longer than the plateau puts the reading ``tau / duration`` times this behind the die) ...
+DRIFT_LIMIT = 0.05
 #: ... when the move is also this many times its own 1-sigma.
 DRIFT_Z = 5.0
 
@@ -196,11 +199,14 @@ class Limits:
         None: no point was visited on both branches.
     drifts : tuple of Drift
         One per plateau fitted, in time order.
+    sensor_lag : float or None
+        Time constant [s] the plateaus' temperatures were corrected for (:func:`lag_corrected`).
     """
 
     accelerometer: Hysteresis | None
     gyro: Hysteresis | None
     drifts: tuple[Drift, ...]
+    sensor_lag: float | None = None
 
     def widen(self, sensor: str, model):
         """`model` (a :class:`~gyrocal.imu.thermal_model.TemperatureModel`) with the sensor's hysteresis
@@ -232,10 +238,13 @@ class Limits:
         moving = [d for d in self.drifts if d.flagged]
         if moving:
             worst = max(moving, key=lambda d: abs(d.drift))
+            what = (f"each plateau's temperature moved to the die's for a sensor lag of {self.sensor_lag:g} s "
+                    "(mean + lag x rate)" if self.sensor_lag else
+                    "a sensor that lags the die reads behind it by its time constant times the rate, which is not "
+                    "in the model's 1-sigma; soak longer, read the die's own sensor, or give the sensor's lag")
             out.append(f"temperature still moving during the poses of {len(moving)} of {len(self.drifts)} plateaus "
                        f"(largest {worst.drift:+.2f} degC over {worst.duration:.0f} s at {worst.temperature:.1f} "
-                       "degC): a sensor that lags the die reads behind it by its time constant times the rate, "
-                       "which is not in the model's 1-sigma; soak longer or read the die's own sensor")
+                       f"degC): {what}")
         return tuple(out)
 
     def to_dict(self) -> dict:
@@ -247,11 +256,11 @@ class Limits:
         return {"flags": flags,
                 "hysteresis": {s: None if h is None else h.to_dict()
                                for s, h in (("accelerometer", self.accelerometer), ("gyro", self.gyro))},
-                "temperature_drift": {"limit_degC": DRIFT_LIMIT, "z": DRIFT_Z,
+                "temperature_drift": {"limit_degC": DRIFT_LIMIT, "z": DRIFT_Z, "sensor_lag_s": self.sensor_lag,
                                       "plateaus": [{**d.to_dict(), "flagged": d.flagged} for d in self.drifts]}}
 
 
-def assess(t, temp, fitted, groups, gyro_params: int, tol: float = 1.0) -> Limits:
+def assess(t, temp, fitted, groups, gyro_params: int, tol: float = 1.0, sensor_lag: float | None = None) -> Limits:
     """The :class:`Limits` of plateau fits `fitted` ((Plateau, ImuCalibrationResult) in time order) joined into
     points `groups`; the gyro's first `gyro_params` parameters are its model's."""
     plateaus = [p for p, _ in fitted]
@@ -261,7 +270,7 @@ def assess(t, temp, fitted, groups, gyro_params: int, tol: float = 1.0) -> Limit
                      results[0].accel.param_names, tol)
     gyr = hysteresis(groups, plateaus, [r.gyro.params[:k] for r in results],
                      [r.gyro.covariance[:k, :k] for r in results], results[0].gyro.param_names[:k], tol)
-    return Limits(acc, gyr, tuple(plateau_drift(t, temp, p) for p in plateaus))
+    return Limits(acc, gyr, tuple(plateau_drift(t, temp, p) for p in plateaus), sensor_lag or None)
 
 
 def _rank(model: str, order) -> int:
@@ -309,3 +318,11 @@ def too_few_poses(fitted, tol: float, orders: dict, fixed: dict) -> tuple[list, 
                   f"{len(r.statics)} poses determine only the {r.accel.model} accelerometer and {r.gyro.model} "
                   f"gyro models, the others' {best.get('accel', r.accel.model)} and {best.get('gyro', r.gyro.model)}"
                   for p, r in dropped]
+
+
+def lag_corrected(t, temp, plateaus: list[Plateau], tau: float | None) -> list[Plateau]:
+    """`plateaus` with each temperature moved to the die's for a sensor lagging it by `tau` [s]: the mean reading
+    plus `tau` times the readings' slope (None or 0: unchanged)."""
+    if not tau:
+        return plateaus
+    return [replace(p, temperature=p.temperature + tau * plateau_drift(t, temp, p).rate) for p in plateaus]
