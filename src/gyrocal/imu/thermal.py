@@ -235,7 +235,16 @@ def calibrate_imu_thermal(t, gyro, accel, temp, *, gravity: float = STANDARD_GRA
                                                      [p.gyro_cov for p in points], max_order))
     ref = int(np.argmin(np.abs(np.array(nodes) - 25.0)))
     return ImuThermalResult(points=points, accel_model=am, gyro_model=gm, accel=a_model, gyro=g_model,
-                            reference=ref, notes=tuple(notes) + limits.notes(), limits=limits)
+                            reference=ref, notes=tuple(notes) + limits.notes() + _misfits(a_model, g_model), limits=limits)
+
+
+def _misfits(*models: TemperatureModel) -> tuple[str, ...]:
+    """A note naming the parameters whose highest order tried misfits the points (1-sigma scaled by it)."""
+    bad = [f"{n} x{np.sqrt(k):.2g}" for m in models for n, k in zip(m.names, m.misfit_scale) if k > 1]
+    if not bad:
+        return ()
+    return (f"the smooth model misfits its points at the highest order the points allow, its 1-sigma scaled "
+            f"(Birge ratio): {', '.join(bad)}; more temperature points would let it follow them",)
 
 
 def _smooth_values(doc, temp: np.ndarray) -> np.ndarray:
