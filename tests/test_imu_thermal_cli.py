@@ -9,7 +9,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from cli_runner import invoke, refused
+from cli_runner import invoke
 from imu_chamber import TEMPS, Truth, chamber
 
 from gyrocal import firmware
