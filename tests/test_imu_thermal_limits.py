@@ -14,6 +14,7 @@ import pytest
 from cli_runner import invoke
 
 from gyrocal.imu.thermal import calibrate_imu_thermal
+from gyrocal.io import write_csv
 from gyrocal.models import ScaleBias
 from gyrocal.simulation.chamber import chamber_session, random_thermal_imu
 from gyrocal.simulation.sensor_lag import lagged_temperature
@@ -181,3 +182,23 @@ def test_thermal_report_on_an_imu_file_beats_the_baseline_by_the_factor_the_trut
     summary = np.genfromtxt(tmp_path / "rep" / "summary.csv", delimiter=",", names=True, dtype=None, encoding=None)
     assert summary["scheme"].tolist() == ["single", "lagrange", "smooth"]
     assert summary["accel_factor"][2] > 20
+
+
+def test_imu_warns_of_a_lagging_sensor_and_temp_lag_moves_the_points_to_the_die(tmp_path):
+    """The CLI on a simulated log whose temperature column lags the die by 300 s (sidecar truth: the die at the
+    set points): the warning and the file's flag; with --temp-lag 300 the points sit at the set points."""
+    truth = _sim(tmp_path / "sim.csv", TEMPS, 6)
+    data = np.genfromtxt(tmp_path / "sim.csv", delimiter=",", names=True, skip_header=1)
+    cols = {k: data[k] for k in data.dtype.names}
+    cols["temp"] = lagged_temperature(data["t"], data["temp"], truth["points"], 300.0)
+    write_csv(tmp_path / "lag.csv", cols)
+    for extra, near in (((), 0.5), (("--temp-lag", "300"), 0.1)):
+        cal = tmp_path / f"cal{len(extra)}.json"
+        code, out, err = invoke("imu", tmp_path / "lag.csv", "--units", "deg/s", "--accel-units", "m/s^2", *extra,
+                                "-o", cal)
+        assert code == 0, err
+        assert "temperature still moving during the poses of 4 of 5 plateaus" in out + err
+        section = json.loads(cal.read_text())["accelerometer"]["thermal"]
+        assert "temperature moving during plateaus" in section["limits"]["flags"]
+        offsets = np.array([p["temperature"] for p in section["points"]]) - TEMPS
+        assert (np.abs(offsets[1:]) > near).all() if not extra else (np.abs(offsets) < near).all(), offsets
