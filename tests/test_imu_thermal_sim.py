@@ -110,17 +110,21 @@ def test_chamber_flags_are_refused_where_they_mean_nothing(tmp_path):
                                       "-o", tmp_path / "b.csv")
     assert "--temp-range" in refused("plan", "--design", "poses", "--temp-points", "5", "--temp-range", "9:1")
     assert "--target-cross" in refused("plan", "--design", "poses", "--temp-points", "5", "--target-cross", "1e-3")
+    code, out, err = invoke("plan", "--design", "poses", "--temp-points", "5", "--target-bias", "0.001deg/s")
+    assert code == 0, err
+    assert "gyro bias across the range" in out and "gyro scale at a point" in out
 
 
 def test_plan_predicts_the_scatter_of_the_temperature_model_over_seeded_sessions():
     """Reference: 6 seeded boards simulated and fitted by gyrocal imu's thermal calibration; the error of the
-    accelerometer's smooth model between the points over the plan's 1-sigma there (Cramer-Rao per point
-    carried through the weighted polynomial). Orders chosen below the top lower the variance, a missed
-    cubic raises it: the two-sided band holds the ratio of empirical to predicted variance."""
+    accelerometer's smooth model (and the gyro's bias) between the points over the plan's 1-sigma there
+    (Cramer-Rao per point carried through the weighted polynomial). Orders chosen below the top lower the
+    variance, a missed cubic raises it: the two-sided band holds the ratio of empirical to predicted variance."""
     plan = predict_poses(POSES, 90.0, static_duration=STILL, sample_rate=FS, accel_noise_density=ACCEL_DENSITY,
                          gyro_noise_density=np.radians(0.01))
     predicted = smooth_sigma(TEMPS, np.tile(plan.accel_std, (len(TEMPS), 1)), MID)
-    z = []
+    gyro_predicted = smooth_sigma(TEMPS, np.tile(plan.gyro_std, (len(TEMPS), 1)), MID)[:, 9:]
+    z, zg = [], []
     for seed in range(6):
         rng = np.random.default_rng(seed)
         truth = random_thermal_imu(ScaleBias((1.0, 1.0, 1.0), (0.0, 0.0, 0.0)), rng)
@@ -129,9 +133,13 @@ def test_plan_predicts_the_scatter_of_the_temperature_model_over_seeded_sessions
         fit = calibrate_imu_thermal(rec.t, rec.gyro, rec.accel, rec.temp)
         est, _ = fit.accel.smooth_at(MID)
         z.append((est - np.array([truth.params(t)[0][_LOWER] for t in MID])) / predicted)
-    ratio = float(np.mean(np.square(z)))
-    print(f"empirical / predicted variance between the points: {ratio:.2f} (6 boards, 9 parameters, 4 temperatures)")
+        gest, _ = fit.gyro.smooth_at(MID)
+        zg.append((gest[:, 9:] - np.array([truth.params(t)[1][9:] for t in MID])) / gyro_predicted)
+    ratio, gyro_ratio = float(np.mean(np.square(z))), float(np.mean(np.square(zg)))
+    print(f"empirical / predicted variance between the points: accelerometer {ratio:.2f} (6 boards, 9 parameters, "
+          f"4 temperatures), gyro bias {gyro_ratio:.2f}")
     assert 0.6 < ratio < 1.6
+    assert 0.6 < gyro_ratio < 1.6
 
 
 def test_more_points_and_poses_help_and_the_suggestion_is_the_smallest_that_meets_the_target():

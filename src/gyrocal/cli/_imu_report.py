@@ -164,3 +164,8 @@ def _print_thermal(run) -> None:
         console.print(f"  {name}: smooth polynomial orders {orders} (and 3-node Lagrange)", highlight=False,
                       soft_wrap=True, markup=False)
     console.print(f"  frame: {th.to_dict()['frame']}", highlight=False, soft_wrap=True, markup=False)
+    limits = getattr(th, "limits", None)
+    for sensor in ("accelerometer", "gyro"):
+        h = None if limits is None else getattr(limits, sensor)
+        if h is not None:
+            console.print(f"  branches: {h.describe(sensor)}", highlight=False, soft_wrap=True, markup=False)

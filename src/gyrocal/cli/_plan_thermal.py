@@ -30,7 +30,8 @@ def plan_thermal(points: int, poses: int, tilt: float, span: str, targets: dict,
     other = sorted({flags[k] for k in set(targets) - set(THERMAL_FIGURES)})
     if other:
         raise InputError(f"--temp-points plans the accelerometer's scale and offset (--target-accel-scale, "
-                         f"--target-accel-offset); drop {', '.join(other)} or --temp-points")
+                         f"--target-accel-offset) and the gyro's scale and bias (--target-scale, --target-bias); "
+                         f"drop {', '.join(other)} or --temp-points")
     if points < 3:
         raise InputError(f"--temp-points must be 3 or more (a model in temperature needs 3 points), got {points}")
     rng = temp_range(span)
@@ -46,7 +47,9 @@ def plan_thermal(points: int, poses: int, tilt: float, span: str, targets: dict,
             ("polynomial order", lambda p: str(p.order)),
             ("pose time, all points (s)", lambda p: f"{p.total_time:.0f}")]
     for key, label, scale, unit in (("accel_scale", "accel scale", 1e4, "1e-4"),
-                                    ("accel_offset", "accel offset", 1.0, "m/s^2")):
+                                    ("accel_offset", "accel offset", 1.0, "m/s^2"),
+                                    ("gyro_scale", "gyro scale", 1e4, "1e-4"),
+                                    ("gyro_bias", "gyro bias", 180 / 3.141592653589793, "deg/s")):
         rows += [(f"{label} at a point ({unit})", lambda p, k=key, s=scale: f"{s * p.per_point[k]:.3g}"),
                  (f"{label} across the range, largest ({unit})", lambda p, k=key, s=scale: f"{s * p.between[k]:.3g}"),
                  (f"{label} across the range, RMS ({unit})", lambda p, k=key, s=scale: f"{s * p.between_rms[k]:.3g}")]

@@ -57,6 +57,10 @@ def imu(
     threshold: Annotated[Optional[float], typer.Option(
         "--threshold", help="Multiplier of the stillness thresholds measured at rest, e.g. 100 for poses held by "
         "hand (default: several are tried and the accelerometer fit picks one).")] = None,
+    temp_lag: Annotated[Optional[float], typer.Option(
+        "--temp-lag", help="A chamber log: time constant of a temperature sensor that lags the die [s]; each "
+        "plateau's temperature is moved to the die's, mean + lag x its drift rate (default: none, as read).")]
+    = None,
     accel_output_units: Annotated[AccelOutputUnit, typer.Option(
         "--accel-output-units", help="Unit of corrected accelerations.")] = "m/s^2",
     output: Annotated[Optional[Path], typer.Option(
@@ -70,6 +74,7 @@ def imu(
     flags: StationFlags = StationFlags(),
 ) -> None:
     """Calibrate gyro and accelerometer together from still poses and hand turns (no turntable needed)."""
+    from .._validation import positive
     from ..errors import InputError
 
     units = required_units(units)
@@ -95,7 +100,8 @@ def imu(
     result = run_job("imu", recording=rec, sources=(recording, accel_log), windows=windows, gravity=gravity,
                      accel_model=accel_model, gyro_model=gyro_model, g_sensitivity=g_sensitivity,
                      min_static=min_static, output_units=output_units, accel_output_units=accel_output_units,
-                     threshold=threshold, accept_implausible=accept_implausible)
+                     threshold=threshold, accept_implausible=accept_implausible,
+                     sensor_lag=None if temp_lag is None else positive("temp_lag", temp_lag))
     if result.implausible is not None:
         warn(result.implausible)
     run = result.value

@@ -149,8 +149,8 @@ def _print_table(cal, fit) -> None:
 
 
 def _load_table(path: Path, load_thermal):
-    """The gyro thermal table of `path`; an IMU thermal calibration (``gyrocal imu``) is refused in one line
-    naming what the report evaluates."""
+    """The gyro thermal table of `path`, or an IMU thermal calibration (``gyrocal imu`` on a chamber log:
+    a calibration with ``accelerometer.thermal``); other files are refused with the table's error."""
     from ..errors import FileFormatError, GyrocalError
 
     try:
@@ -163,17 +163,16 @@ def _load_table(path: Path, load_thermal):
         except (GyrocalError, OSError, ValueError):  # the first error is the one to show
             other = None
         if (getattr(other, "accelerometer", None) or {}).get("thermal") is not None:
-            raise InputError(f"{path} is an IMU thermal calibration (gyrocal imu, accelerometer.thermal); "
-                             "thermal-report evaluates only a gyro table from 'gyrocal thermal' on a turntable test "
-                             "log (table_rate steps); check an IMU one with 'gyrocal apply' at the test "
-                             "temperatures") from None
+            return other
         raise
 
 
 @app.command("thermal-report")
 def thermal_report(
-    calibration: Annotated[Path, typer.Argument(help="Thermal calibration file from 'gyrocal thermal'.")],
-    test: Annotated[Path, typer.Argument(help="Test recording (or folder) with t, gx, gy, gz, temp, table_rate, axis.")],
+    calibration: Annotated[Path, typer.Argument(help="Thermal calibration file from 'gyrocal thermal', or from "
+                                                     "'gyrocal imu' on a chamber log.")],
+    test: Annotated[Path, typer.Argument(help="Test recording (or folder) with t, gx, gy, gz, temp, table_rate, axis; "
+                                              "for an IMU calibration a pose log with t, gx..az, temp.")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Report folder to write.")],
     units: Annotated[Optional[str], typer.Option("--units", help="Unit of the test data (default: the calibration's input unit).",
                                                           metavar="<rad/s|deg/s|counts>")] = None,
@@ -188,6 +187,9 @@ def thermal_report(
         "--out-of-range", help="Test temperatures outside the calibrated range: refuse, clamp or extrapolate.")
     ] = "refuse",
     figures: Annotated[bool, typer.Option("--figures/--no-figures", help="Draw the PNG figures.")] = True,
+    accel_units: Annotated[Optional[str], typer.Option(
+        "--accel-units", help="An IMU calibration's test log: unit of ax, ay, az (default: the calibration's "
+        "accelerometer input unit).", metavar="<m/s^2|g|counts>")] = None,
 ) -> None:
     """Compare uncompensated, traditional, Lagrange and smooth compensation on a test recording."""
     from ..plotting.thermal_report import write_report
@@ -197,6 +199,14 @@ def thermal_report(
     refuse_swapped(calibration, test, command="thermal-report", usage="thermal file from 'gyrocal thermal' comes")
     check_output(output, inputs=(calibration, test), folder=True)
     cal = _load_table(calibration, load_thermal)
+    if getattr(cal, "accelerometer", None) is not None:
+        from ._imu_thermal_report import imu_thermal_report
+
+        return imu_thermal_report(cal, test, output, units=units, accel_units=accel_units, columns=columns,
+                                  skip_rows=skip_rows, sample_rate=sample_rate, figures=figures)
+    if accel_units is not None:
+        raise InputError("--accel-units is for an IMU thermal calibration (gyrocal imu); a gyro table's test log "
+                         "has no accelerometer")
     units = units or cal.input_units
     with warnings_as_lines():
         recs, _ = _read(test, units, columns, sample_rate, sensitivity, cal.output_units if units == "counts" else None,

@@ -116,7 +116,7 @@ def _unit_hint(k: np.ndarray, factor: float, big: str, small: str) -> str:
 def calibrate_recording(rec: Recording, *, windows=None, gravity: float = STANDARD_GRAVITY, accel_model="auto",
                         gyro_model="auto", g_sensitivity: bool = False, min_static: float = 1.0,
                         output_units: str | None = None, accel_output_units: str = "m/s^2",
-                        threshold: float | None = None) -> ImuRun:
+                        threshold: float | None = None, sensor_lag: float | None = None) -> ImuRun:
     """Calibrate the gyro and the accelerometer of a hand session.
 
     Parameters
@@ -133,6 +133,9 @@ def calibrate_recording(rec: Recording, *, windows=None, gravity: float = STANDA
         Of the corrected rates; default the data's, deg/s for counts.
     accel_output_units : {"m/s^2", "g"}
         Of the corrected accelerations.
+    sensor_lag : float, optional
+        A chamber log's temperature sensor lags the die by this time constant [s]
+        (:func:`~gyrocal.imu.thermal_limits.lag_corrected`).
     """
     if rec.accel is None:
         raise InputError("the recording has no accelerometer columns; a whole-IMU calibration needs them",
@@ -148,7 +151,7 @@ def calibrate_recording(rec: Recording, *, windows=None, gravity: float = STANDA
     kw = {"gravity": gravity, "accel_model": accel_model, "gyro_model": gyro_model, "min_static": min_static,
           "gaps": [g.index for g in tb.gaps if g.lost > MAX_LOST], "breaks": tb.breaks, "threshold": threshold}
     t = rec.t if clock is None else clock
-    thermal, result = _thermal(rec, t, kw) if windows is None and not g_sensitivity else (None, None)
+    thermal, result = _thermal(rec, t, kw, sensor_lag) if windows is None and not g_sensitivity else (None, None)
     if result is None:
         result = calibrate_imu(t, rec.gyro, rec.accel, windows=windows, g_sensitivity=g_sensitivity, **kw)
     cal = _calibration(result, rec, tb, out_units, accel_output_units, gravity)
@@ -159,13 +162,13 @@ def calibrate_recording(rec: Recording, *, windows=None, gravity: float = STANDA
     return ImuRun(result, cal, tb, thermal)
 
 
-def _thermal(rec: Recording, t, kw) -> tuple[ImuThermalResult | None, ImuCalibrationResult | None]:
+def _thermal(rec: Recording, t, kw, sensor_lag=None) -> tuple[ImuThermalResult | None, ImuCalibrationResult | None]:
     """Both sensors across temperature when the temperature column spans several points, and the result at the
     point nearest 25 degC (the file's correction); a span that gives no model is said in that result's warnings."""
     if rec.temp is None or np.ptp(rec.temp) <= THERMAL_SPAN:
         return None, None
     try:
-        thermal = calibrate_imu_thermal(t, rec.gyro, rec.accel, rec.temp, **kw)
+        thermal = calibrate_imu_thermal(t, rec.gyro, rec.accel, rec.temp, sensor_lag=sensor_lag, **kw)
     except InputError as exc:
         result = calibrate_imu(t, rec.gyro, rec.accel, **kw)
         why = (f"the temperature column spans {np.ptp(rec.temp):.1f} degC but no model in temperature was fitted "

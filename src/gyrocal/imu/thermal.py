@@ -21,7 +21,7 @@ model. The gyro's correction maps onto the corrected accelerometer frame at the 
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -31,6 +31,7 @@ from ._gyro_solve import MASKS
 from .accel import model_matrices
 from .plateaus import Plateau, find_plateaus, temperature_points
 from .session import ImuCalibrationResult, calibrate_imu
+from .thermal_limits import Limits, assess, branches, lag_corrected, too_few_poses
 from .thermal_model import TemperatureModel, temperature_model
 
 __all__ = ["FRAME", "ImuPoint", "ImuThermalResult", "calibrate_imu_thermal", "correct_with_section", "sensor_matrices"]
@@ -87,7 +88,10 @@ class ImuThermalResult:
     reference : int
         Index of the point nearest 25 degC: the single-temperature calibration.
     notes : tuple of str
-        Plateaus left out and why.
+        Plateaus left out and why, and the limits flagged.
+    limits : Limits or None
+        Hysteresis between the heating and cooling branches, and temperature drift within plateaus
+        (:mod:`gyrocal.imu.thermal_limits`).
     """
 
     points: tuple[ImuPoint, ...]
@@ -97,6 +101,7 @@ class ImuThermalResult:
     gyro: TemperatureModel
     reference: int
     notes: tuple[str, ...] = ()
+    limits: Limits | None = field(default=None, compare=False)
 
     def correct_accel(self, readings, temp, scheme: str = "smooth") -> np.ndarray:
         """Specific force (N, 3) [m/s^2] from readings (N, 3) at temperatures (N,) [degC]."""
@@ -124,6 +129,7 @@ class ImuThermalResult:
             "accelerometer": {"model": self.accel_model, **self.accel.to_dict()},
             "gyro": {"model": self.gyro_model, **self.gyro.to_dict()},
             "notes": list(self.notes),
+            **({} if self.limits is None else {"limits": self.limits.to_dict()}),
         }
 
 
@@ -154,21 +160,14 @@ def _harmonise(t, gyro, accel, fitted, gaps, kw, accel_model, gyro_model):
     return out, am, gm
 
 
-def _join(params: list[np.ndarray], covs: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """Inverse-covariance mean of independent estimates of one parameter vector."""
-    if len(params) == 1:
-        return params[0], covs[0]
-    info = [np.linalg.inv(c) for c in covs]
-    cov = np.linalg.inv(sum(info))
-    return cov @ sum(i @ p for i, p in zip(info, params)), cov
-
-
-def _point(group: list[tuple[Plateau, ImuCalibrationResult]]) -> ImuPoint:
+def _point(group: list[tuple[Plateau, ImuCalibrationResult]], sides: list[str], limits: Limits) -> ImuPoint:
     plateaus = tuple(p for p, _ in group)
     results = tuple(r for _, r in group)
-    a, a_cov = _join([r.accel.params for r in results], [r.accel.covariance for r in results])
+    a, a_cov = limits.join("accelerometer", [r.accel.params for r in results], [r.accel.covariance for r in results],
+                           sides)
     k = int(MASKS[results[0].gyro.model].sum()) + 3
-    g, g_cov = _join([r.gyro.params[:k] for r in results], [r.gyro.covariance[:k, :k] for r in results])
+    g, g_cov = limits.join("gyro", [r.gyro.params[:k] for r in results], [r.gyro.covariance[:k, :k] for r in results],
+                           sides)
     weights = np.array([p.stop - p.start for p in plateaus], dtype=float)
     temps = np.array([p.temperature for p in plateaus])
     spread = np.sqrt(np.average([p.temp_std**2 for p in plateaus], weights=weights)
@@ -179,7 +178,8 @@ def _point(group: list[tuple[Plateau, ImuCalibrationResult]]) -> ImuPoint:
 
 def calibrate_imu_thermal(t, gyro, accel, temp, *, gravity: float = STANDARD_GRAVITY, accel_model="auto",
                           gyro_model="auto", min_static: float = 1.0, gaps=(), breaks=(), threshold=None,
-                          tol: float = 1.0, min_plateau: float = 30.0, max_order: int = 3) -> ImuThermalResult:
+                          tol: float = 1.0, min_plateau: float = 30.0, max_order: int = 3,
+                          sensor_lag: float | None = None) -> ImuThermalResult:
     """Calibrate both sensors at each temperature point of a chamber log and model them in temperature.
 
     Parameters
@@ -192,6 +192,8 @@ def calibrate_imu_thermal(t, gyro, accel, temp, *, gravity: float = STANDARD_GRA
         See :func:`~gyrocal.imu.plateaus.find_plateaus` [degC, s].
     max_order : int
         Highest order of the smooth polynomial tried.
+    sensor_lag : float, optional
+        Time constant [s] of a temperature sensor that lags the die (:func:`~gyrocal.imu.thermal_limits.lag_corrected`).
 
     Raises
     ------
@@ -202,7 +204,9 @@ def calibrate_imu_thermal(t, gyro, accel, temp, *, gravity: float = STANDARD_GRA
     kw = {"gravity": gravity, "accel_model": accel_model, "gyro_model": gyro_model, "min_static": min_static,
           "threshold": threshold}
     fitted, notes = [], []
-    for plateau in find_plateaus(t, temp, breaks=breaks, tol=tol, min_duration=min_plateau):
+    temp = np.asarray(temp, dtype=float)
+    for plateau in lag_corrected(t, temp, find_plateaus(t, temp, breaks=breaks, tol=tol, min_duration=min_plateau),
+                                 sensor_lag):
         try:
             fitted.append((plateau, _fit_plateau(t, gyro, accel, plateau, gaps, kw)))
         except (DegenerateDesignError, SegmentationError) as exc:
@@ -210,22 +214,37 @@ def calibrate_imu_thermal(t, gyro, accel, temp, *, gravity: float = STANDARD_GRA
                          f"left out: {str(exc).splitlines()[0]}")
     if not fitted:
         raise InputError("no temperature plateau holds poses that determine the accelerometer and the gyro")
+    fitted, few = too_few_poses(fitted, tol, {"accel": _ACCEL_ORDER, "gyro": _GYRO_ORDER},
+                                {"accel": None if accel_model == "auto" else accel_model,
+                                 "gyro": None if gyro_model == "auto" else gyro_model})
+    notes += few
     fitted, am, gm = _harmonise(t, gyro, accel, fitted, gaps, kw, accel_model, gyro_model)
     groups = temperature_points([p for p, _ in fitted], tol)
-    points = tuple(_point([fitted[k] for k in g]) for g in groups)
+    k = int(MASKS[gm].sum()) + 3
+    limits = assess(t, temp, fitted, groups, k, tol, sensor_lag)
+    sides = branches([p for p, _ in fitted], tol)
+    points = tuple(_point([fitted[i] for i in g], [sides[i] for i in g], limits) for g in groups)
     if len(points) < 3:
         raise InputError(f"a model in temperature needs poses at 3 or more temperature points; this log has "
                          f"{len(points)} ({', '.join(f'{p.temperature:.1f}' for p in points)} degC)")
     nodes = [p.temperature for p in points]
     first = points[0].results[0]
-    a_model = temperature_model(first.accel.param_names, nodes, [p.accel for p in points],
-                                [p.accel_cov for p in points], max_order)
-    k = len(points[0].gyro)
-    g_model = temperature_model(first.gyro.param_names[:k], nodes, [p.gyro for p in points],
-                                [p.gyro_cov for p in points], max_order)
+    a_model = limits.widen("accelerometer", temperature_model(
+        first.accel.param_names, nodes, [p.accel for p in points], [p.accel_cov for p in points], max_order))
+    g_model = limits.widen("gyro", temperature_model(first.gyro.param_names[:k], nodes, [p.gyro for p in points],
+                                                     [p.gyro_cov for p in points], max_order))
     ref = int(np.argmin(np.abs(np.array(nodes) - 25.0)))
     return ImuThermalResult(points=points, accel_model=am, gyro_model=gm, accel=a_model, gyro=g_model,
-                            reference=ref, notes=tuple(notes))
+                            reference=ref, notes=tuple(notes) + limits.notes() + _misfits(a_model, g_model), limits=limits)
+
+
+def _misfits(*models: TemperatureModel) -> tuple[str, ...]:
+    """A note naming the parameters whose highest order tried misfits the points (1-sigma scaled by it)."""
+    bad = [f"{n} x{np.sqrt(k):.2g}" for m in models for n, k in zip(m.names, m.misfit_scale) if k > 1]
+    if not bad:
+        return ()
+    return (f"the smooth model misfits its points at the highest order the points allow, its 1-sigma scaled "
+            f"(Birge ratio): {', '.join(bad)}; more temperature points would let it follow them",)
 
 
 def _smooth_values(doc, temp: np.ndarray) -> np.ndarray:

@@ -13,7 +13,9 @@ error: the difference ``d`` between its polynomial and the highest order's weigh
 the terms it leaves out (its expectation ``bias^2`` plus the variance the extra terms would add), and
 ``d d^T`` is added to that parameter's block of the coefficients' covariance (chamber simulations:
 without it the RMS z between the points was 1.3 against 1.0). Points are independent of one another (each
-comes from its own poses), so the Lagrange value's covariance is ``sum_k w_k^2 C_k``.
+comes from its own poses), so the Lagrange value's covariance is ``sum_k w_k^2 C_k``. A parameter whose highest
+order tried (``n - 2`` for ``n`` points) still misfits them (a cubic seen at 4 points) has its variance scaled by
+``chi2 / dof`` (the Birge ratio squared), so the misfit the model cannot follow is in its 1-sigma.
 """
 
 from __future__ import annotations
@@ -55,6 +57,9 @@ class TemperatureModel:
         Of ``smooth.coefs.ravel()``.
     chi2 : ndarray, shape (m,)
         Weighted misfit of each parameter's polynomial at the points (``n - order - 1`` dof).
+    misfit_scale : ndarray, shape (m,)
+        Factor on each parameter's variance: ``chi2 / dof`` where the highest order tried still misfits the
+        points (p-value below :data:`MISFIT_P`), else 1.
     """
 
     names: tuple[str, ...]
@@ -64,6 +69,7 @@ class TemperatureModel:
     smooth: SmoothModel
     smooth_covariance: np.ndarray
     chi2: np.ndarray
+    misfit_scale: np.ndarray | None = None
 
     def smooth_at(self, temp) -> tuple[np.ndarray, np.ndarray]:
         """Values and 1-sigma (N, m) of the smooth polynomials at temperatures (N,) [degC]."""
@@ -89,6 +95,15 @@ class TemperatureModel:
             raise InputError(f"scheme must be one of {', '.join(SCHEMES)}, got {scheme!r}")
         return self.smooth_at(temp) if scheme == "smooth" else self.lagrange_at(temp)
 
+    def with_constant_variance(self, variance) -> "TemperatureModel":
+        """This model with `variance` (m,) added to each parameter's constant coefficient: a variance at every
+        temperature alike (an error the points share, such as half a hysteresis)."""
+        m, width = len(self.names), self.smooth.coefs.shape[1]
+        idx = np.arange(m) * width
+        cov = self.smooth_covariance.copy()
+        cov[idx, idx] += np.asarray(variance, dtype=float)
+        return replace(self, smooth_covariance=cov)
+
     def to_dict(self) -> dict:
         """The file's form: points, the smooth model with its coefficients' covariance, the misfit."""
         return {
@@ -100,6 +115,8 @@ class TemperatureModel:
                        "std": np.sqrt(np.maximum(np.diag(self.smooth_covariance), 0.0))
                        .reshape(self.smooth.coefs.shape).tolist(),
                        "chi2": self.chi2.tolist(),
+                       "misfit_scale": (np.ones(len(self.names)) if self.misfit_scale is None
+                                        else self.misfit_scale).tolist(),
                        "dof": [len(self.nodes) - int(p) - 1 for p in self.smooth.orders]},
         }
 
@@ -135,8 +152,11 @@ def temperature_model(names, nodes, values, covariances, max_order: int = 3) -> 
         if not raise_.any():
             break
         chosen = replace(chosen, orders=chosen.orders + raise_)
-    cov = cov + _order_error(chosen, nodes, values, covariances, coefs)
+    misfit = (chosen.orders == top) & (dof > 0) & (stats.chi2.sf(chi2, np.maximum(dof, 1)) < MISFIT_P)
+    scale = np.where(misfit, chi2 / np.maximum(dof, 1), 1.0)
+    s = np.repeat(np.sqrt(scale), coefs.shape[1])
+    cov = cov * np.outer(s, s) + _order_error(chosen, nodes, values, covariances, coefs)
     smooth = SmoothModel(centre=chosen.centre, scale=chosen.scale, orders=chosen.orders, coefs=coefs,
                          loto_rms=chosen.loto_rms)
     return TemperatureModel(names=tuple(names), nodes=nodes, values=values, covariances=covariances, smooth=smooth,
-                            smooth_covariance=cov, chi2=chi2)
+                            smooth_covariance=cov, chi2=chi2, misfit_scale=scale)

@@ -26,10 +26,12 @@ from .thermal_model import TemperatureModel
 __all__ = ["THERMAL_FIGURES", "ThermalPlan", "predict_thermal", "smooth_sigma", "suggest_thermal"]
 
 #: The figures a chamber plan reports, and a target may name.
-THERMAL_FIGURES = ("accel_scale", "accel_offset")
+THERMAL_FIGURES = ("accel_scale", "accel_offset", "gyro_scale", "gyro_bias")
 _NAMES = param_names("triangular")
-_KIND = {"accel_scale": [_NAMES.index(n) for n in ("A_xx", "A_yy", "A_zz")],
-         "accel_offset": [_NAMES.index(n) for n in ("o_x", "o_y", "o_z")]}
+#: Which sensor's parameters, and which of them, make each figure (the gyro's: its affine ``M`` row-major, bias).
+_KIND = {"accel_scale": ("accel", [_NAMES.index(n) for n in ("A_xx", "A_yy", "A_zz")]),
+         "accel_offset": ("accel", [_NAMES.index(n) for n in ("o_x", "o_y", "o_z")]),
+         "gyro_scale": ("gyro", [0, 4, 8]), "gyro_bias": ("gyro", [9, 10, 11])}
 #: Temperatures across the range at which the smooth model's 1-sigma is evaluated.
 _GRID = 201
 
@@ -70,7 +72,8 @@ class ThermalPlan:
     per_point, between, between_rms : dict of str to float
         Largest 1-sigma of each of :data:`THERMAL_FIGURES` at one point; the smooth polynomial's largest
         anywhere across the range (at its ends, where the polynomial rests on fewest points), and its
-        RMS across the range [-, m/s^2].
+        RMS across the range [-, m/s^2, rad/s]. The gyro's bias is its noise alone: a bias that jumps
+        between turn-ons adds its own repeatability.
     total_time : float
         Pose sequences at every point, soaks not counted [s].
     """
@@ -104,11 +107,12 @@ def predict_thermal(points: int, poses: int = 24, turn_deg: float = 90.0, *, tem
         raise InputError(f"{{param}} must be low:high with low < high [degC], got {temp_range!r}", param="temp_range")
     point = point or predict_poses(poses, turn_deg, **options)
     nodes = np.linspace(lo, hi, int(points))
-    std = np.tile(point.accel_std, (int(points), 1))
-    sigma = smooth_sigma(nodes, std, np.linspace(lo, hi, _GRID))
-    per_point = {k: float(point.accel_std[idx].max()) for k, idx in _KIND.items()}
-    between = {k: float(sigma[:, idx].max()) for k, idx in _KIND.items()}
-    rms = {k: float(np.sqrt(np.mean(sigma[:, idx] ** 2, axis=0)).max()) for k, idx in _KIND.items()}
+    stds = {"accel": point.accel_std, "gyro": point.gyro_std}
+    grid = np.linspace(lo, hi, _GRID)
+    sigma = {s: smooth_sigma(nodes, np.tile(v, (int(points), 1)), grid) for s, v in stds.items()}
+    per_point = {k: float(stds[s][idx].max()) for k, (s, idx) in _KIND.items()}
+    between = {k: float(sigma[s][:, idx].max()) for k, (s, idx) in _KIND.items()}
+    rms = {k: float(np.sqrt(np.mean(sigma[s][:, idx] ** 2, axis=0)).max()) for k, (s, idx) in _KIND.items()}
     return ThermalPlan(points=int(points), poses=point.poses, nodes=nodes, order=min(3, int(points) - 2),
                        point=point, per_point=per_point, between=between,
                        between_rms=rms, total_time=points * point.total_time)

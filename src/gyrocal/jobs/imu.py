@@ -32,6 +32,7 @@ class ImuJob(Job):
     output_units: str | None = None
     accel_output_units: str = "m/s^2"
     accept_implausible: bool = False
+    sensor_lag: float | None = None  # the temperature sensor's lag behind the die [s]
     sources: tuple = ()  # files the recording came from (the recording, the accelerometer's log), when read before
 
     def run(self) -> JobResult:
@@ -49,7 +50,8 @@ class ImuJob(Job):
         run = calibrate_recording(rec, windows=win, gravity=self.gravity, accel_model=self.accel_model,
                                   gyro_model=self.gyro_model, g_sensitivity=self.g_sensitivity,
                                   min_static=self.min_static, output_units=self.output_units,
-                                  accel_output_units=self.accel_output_units, threshold=self.threshold)
+                                  accel_output_units=self.accel_output_units, threshold=self.threshold,
+                                  sensor_lag=self.sensor_lag)
         doc, accepted = judge(run.calibration.to_document(), implausible(run.calibration), self.accept_implausible)
 
         inputs = paths(self.recording, *self.sources[:1], self.windows, *self.sources[1:])
