@@ -164,8 +164,11 @@ def _thermal(rec: Recording, t, kw) -> tuple[ImuThermalResult | None, ImuCalibra
     point nearest 25 degC (the file's correction); a span that gives no model is said in that result's warnings."""
     if rec.temp is None or np.ptp(rec.temp) <= THERMAL_SPAN:
         return None, None
+    from .ramp import calibrate_ramp, is_ramp
+
+    ramp = is_ramp(t, rec.temp, kw["breaks"])
     try:
-        thermal = calibrate_imu_thermal(t, rec.gyro, rec.accel, rec.temp, **kw)
+        thermal = (calibrate_ramp if ramp else calibrate_imu_thermal)(t, rec.gyro, rec.accel, rec.temp, **kw)
     except InputError as exc:
         result = calibrate_imu(t, rec.gyro, rec.accel, **kw)
         why = (f"the temperature column spans {np.ptp(rec.temp):.1f} degC but no model in temperature was fitted "
@@ -173,7 +176,8 @@ def _thermal(rec: Recording, t, kw) -> tuple[ImuThermalResult | None, ImuCalibra
         return None, replace(result, warnings=result.warnings + (why,))
     ref = thermal.points[thermal.reference]
     result = max(ref.results, key=lambda r: len(r.statics))
-    what = (f"{len(thermal.points)} temperature points ({', '.join(f'{p.temperature:.1f}' for p in thermal.points)} "
+    what = ((f"a temperature ramp ({thermal.ramp['poses']} poses, each at its own temperature; the accelerometer "
+             f"fitted across them): " if ramp else "temperature plateaus: ") + f"{len(thermal.points)} temperature points ({', '.join(f'{p.temperature:.1f}' for p in thermal.points)} "
             f"degC): the correction is the point at {ref.temperature:.1f} degC, accelerometer.thermal holds both "
             "sensors at every point and their models in temperature")
     return thermal, replace(result, warnings=result.warnings + thermal.notes + (what,))

@@ -179,7 +179,8 @@ def _point(group: list[tuple[Plateau, ImuCalibrationResult]]) -> ImuPoint:
 
 def calibrate_imu_thermal(t, gyro, accel, temp, *, gravity: float = STANDARD_GRAVITY, accel_model="auto",
                           gyro_model="auto", min_static: float = 1.0, gaps=(), breaks=(), threshold=None,
-                          tol: float = 1.0, min_plateau: float = 30.0, max_order: int = 3) -> ImuThermalResult:
+                          tol: float = 1.0, min_plateau: float = 30.0, max_order: int = 3,
+                          plateaus: list[Plateau] | None = None) -> ImuThermalResult:
     """Calibrate both sensors at each temperature point of a chamber log and model them in temperature.
 
     Parameters
@@ -192,6 +193,9 @@ def calibrate_imu_thermal(t, gyro, accel, temp, *, gravity: float = STANDARD_GRA
         See :func:`~gyrocal.imu.plateaus.find_plateaus` [degC, s].
     max_order : int
         Highest order of the smooth polynomial tried.
+    plateaus : list of Plateau, optional
+        The parts of the log to calibrate on their own (a ramp's temperature bins,
+        :func:`~gyrocal.imu.ramp.ramp_bins`); default :func:`~gyrocal.imu.plateaus.find_plateaus`.
 
     Raises
     ------
@@ -202,7 +206,9 @@ def calibrate_imu_thermal(t, gyro, accel, temp, *, gravity: float = STANDARD_GRA
     kw = {"gravity": gravity, "accel_model": accel_model, "gyro_model": gyro_model, "min_static": min_static,
           "threshold": threshold}
     fitted, notes = [], []
-    for plateau in find_plateaus(t, temp, breaks=breaks, tol=tol, min_duration=min_plateau):
+    if plateaus is None:
+        plateaus = find_plateaus(t, temp, breaks=breaks, tol=tol, min_duration=min_plateau)
+    for plateau in plateaus:
         try:
             fitted.append((plateau, _fit_plateau(t, gyro, accel, plateau, gaps, kw)))
         except (DegenerateDesignError, SegmentationError) as exc:
