@@ -8,7 +8,8 @@ the corrected specific force ``A(T) (u - o(T))`` of the truth's raw reading is c
 
 * z = error / predicted 1-sigma (delta method through the smooth model's coefficient covariance);
   RMS z over all boards, temperatures, directions and components;
-* sigma_f = RMS of the predicted 1-sigma: the figure of merit whose equality sets the time saved.
+* sigma_f = RMS of the predicted 1-sigma: the figure of merit whose equality sets the time saved;
+* on the ramps, the gyro's 12 parameters against the truth at the same temperatures (RMS z).
 
 Chamber time: plateaus ``(points - 1) * soak + recorded time``; a ramp ``(high - low) / rate``.
 
@@ -64,6 +65,12 @@ def corrected_z(model, truth) -> tuple[np.ndarray, np.ndarray]:
     return zs, sig
 
 
+def gyro_z(res, truth) -> np.ndarray:
+    """z-scores (GRID, 12) of the gyro's model (matrix row-major, offset) against the truth's cubics."""
+    value, sigma = res.gyro.at(GRID)
+    return (value - np.array([truth.params(t)[1] for t in GRID])) / sigma
+
+
 def board(seed: int, rates) -> dict:
     """One board: z and sigma_f of the plateau session and of each ramp, and their chamber times [s]."""
     rng = np.random.default_rng(seed)
@@ -76,7 +83,7 @@ def board(seed: int, rates) -> dict:
     for rate in rates:
         rec, facts = ramp_session(truth, -25.0, 60.0, rate, **kw)
         res = calibrate_ramp(rec.t, rec.gyro, rec.accel, rec.temp, threshold=3.0)
-        out[rate] = (*corrected_z(res.accel, truth), facts["duration_s"])
+        out[rate] = (*corrected_z(res.accel, truth), facts["duration_s"], gyro_z(res, truth))
     return out
 
 
@@ -96,6 +103,10 @@ def main() -> None:
         name = "plateaus" if key == "plateaus" else f"ramp {key:g} degC/min"
         print(f"{name:>22}: chamber {minutes:6.1f} min, sigma_f {sig:.3e} m/s^2, RMS z {np.sqrt(np.mean(z**2)):.3f} "
               f"({z.size} z, {args.boards} boards), |z|>3 {np.mean(np.abs(z) > 3):.4f}")
+        if key != "plateaus":
+            zg = np.concatenate([r[key][3].ravel() for r in runs])
+            print(f"{'':>22}  gyro's 12 parameters at the same temperatures: RMS z {np.sqrt(np.mean(zg**2)):.3f} "
+                  f"({zg.size} z)")
     ramps = sorted(rows[1:], key=lambda r: r[1])
     t, s = np.log([r[1] for r in ramps]), np.log([r[2] for r in ramps])
     target = np.log(rows[0][2])

@@ -176,11 +176,21 @@ def _thermal(rec: Recording, t, kw) -> tuple[ImuThermalResult | None, ImuCalibra
         return None, replace(result, warnings=result.warnings + (why,))
     ref = thermal.points[thermal.reference]
     result = max(ref.results, key=lambda r: len(r.statics))
-    what = ((f"a temperature ramp ({thermal.ramp['poses']} poses, each at its own temperature; the accelerometer "
-             f"fitted across them): " if ramp else "temperature plateaus: ") + f"{len(thermal.points)} temperature points ({', '.join(f'{p.temperature:.1f}' for p in thermal.points)} "
-            f"degC): the correction is the point at {ref.temperature:.1f} degC, accelerometer.thermal holds both "
-            "sensors at every point and their models in temperature")
+    what = _what(thermal, ref, ramp)
     return thermal, replace(result, warnings=result.warnings + thermal.notes + (what,))
+
+
+def _what(thermal: ImuThermalResult, ref, ramp: bool) -> str:
+    """The line that says how the log was read across temperature: a ramp or plateaus, the points, the correction."""
+    temps = ", ".join(f"{p.temperature:.1f}" for p in thermal.points)
+    if not ramp:
+        return (f"temperature plateaus: {len(thermal.points)} temperature points ({temps} degC): the correction is "
+                f"the point at {ref.temperature:.1f} degC, accelerometer.thermal holds both sensors at every point and "
+                "their models in temperature")
+    return (f"a temperature ramp ({thermal.ramp['poses']} poses, each at its own temperature; the accelerometer fitted "
+            f"across them, the gyro in {len(thermal.points)} temperature bins at {temps} degC): the correction is the "
+            f"bin at {ref.temperature:.1f} degC, whose accelerometer fit also holds the drift across the bin (its "
+            "residuals above the noise); accelerometer.thermal holds both sensors' models in temperature")
 
 
 def _gyro_model(result: ImuCalibrationResult):
