@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from cli_runner import invoke, refused
 
+from gyrocal.errors import InputError
 from gyrocal.files import load
 from gyrocal.imu.ramp import fit_ramp_accel, is_ramp
 from gyrocal.models import ScaleBias
@@ -73,6 +74,17 @@ def test_order_drops_when_the_truth_is_linear():
         orders.append(int(fit_ramp_accel(_poses(truth, temps, rng), np.full((150, 3), SE), temps,
                                          "triangular").orders.max()))
     assert sum(o == 1 for o in orders) >= 14, orders
+
+
+def test_few_poses_lower_the_order():
+    """20 poses leave spare equations for order 0 only (9 x 2 + 3 > 20); 11 poses for nothing: refused."""
+    rng = np.random.default_rng(7)
+    truth = random_thermal_imu(ScaleBias((1.0, 1.0, 1.0), (0.0, 0.0, 0.0)), rng)
+    temps = np.linspace(-25.0, 60.0, 20)
+    fit = fit_ramp_accel(_poses(truth, temps, rng), np.full((20, 3), SE), temps, "triangular")
+    assert fit.orders.max() == 0 and fit.coefs.shape == (9, 1)
+    with pytest.raises(InputError, match="needs 12 poses or more"):
+        fit_ramp_accel(_poses(truth, temps[:11], rng), np.full((11, 3), SE), temps[:11], "triangular")
 
 
 def test_simulated_ramp_follows_the_truth():

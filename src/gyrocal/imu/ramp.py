@@ -42,7 +42,7 @@ from ..errors import InputError
 from ..thermal.smooth import SmoothModel, loto_errors
 from ..units import STANDARD_GRAVITY
 from . import _fit
-from .accel import model_matrices, param_names
+from .accel import MIN_DOF, model_matrices, param_names
 from .plateaus import Plateau
 from .thermal import ImuThermalResult, calibrate_imu_thermal
 from .thermal_model import TemperatureModel
@@ -213,12 +213,18 @@ def fit_ramp_accel(means, se, temps, model: str, *, gravity: float = STANDARD_GR
     temps : array_like, shape (n,)
         Each pose's mean temperature [degC].
     model : {"scale-bias", "triangular"}
+    max_order : int
+        Highest order tried, lowered until the poses leave :data:`~gyrocal.imu.accel.MIN_DOF` spare equations.
     start : ndarray, shape (m, max_order + 1), optional
         Starting coefficients (in the returned centre and scale); default a unit matrix, zero offset.
     """
     u, se, temps = (np.asarray(a, dtype=float) for a in (means, se, temps))
     if model not in ("scale-bias", "triangular"):
         raise InputError(f"a ramp's accelerometer fit takes scale-bias or triangular, got {model!r}")
+    m = len(param_names(model))
+    if len(u) < m + MIN_DOF:
+        raise InputError(f"a ramp's accelerometer fit needs {m + MIN_DOF} poses or more, got {len(u)}")
+    max_order = min(int(max_order), (len(u) - MIN_DOF) // m - 1)  # every order with MIN_DOF spare equations
     centre, scale = float((temps.max() + temps.min()) / 2), float(max(np.ptp(temps) / 2, 1e-9))
     prob = _Problem(u, se, (temps - centre) / scale, model, gravity, max_order)
     if start is None:
@@ -226,7 +232,7 @@ def fit_ramp_accel(means, se, temps, model: str, *, gravity: float = STANDARD_GR
         start[[i for i, n in enumerate(param_names(model)) if n in ("A_xx", "A_yy", "A_zz")], 0] = 1.0
     order = max_order
     active = np.arange(max_order + 1)[None, :] <= np.full((prob.m, 1), order)
-    top, jac, r = _solve(prob, start, active)
+    top, jac, r = _solve(prob, start[:, : max_order + 1], active)
     coefs = top
     while True:
         q = _fit.quality(r, int(active.sum()), "accelerometer fit across the ramp")
