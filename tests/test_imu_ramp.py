@@ -186,6 +186,7 @@ def test_cli_ramp_apply_and_export(ramp_cli):
     (["--temp-ramp", "-25:60", "--temp-points", "0,25,50"], "give one"),
     (["--temp-ramp", "-25:60", "--temp-soak", "60"], "has none"),
     (["--temp-ramp", "20:20.5"], "1 degC or more apart"),
+    (["--temp-ramp", "-25:60", "--device"], "not used by --device"),
 ])
 def test_cli_ramp_refusals(tmp_path, flags, words):
     """Bad --temp-ramp input: one line, exit 2."""
