@@ -15,7 +15,7 @@ __all__ = ["refuse_device_flags", "serve_device"]
 
 #: Flags of a simulated recording that a served multi-position session does not use (its person follows the
 #: guide's plan; its sensors are an MPU-6050's).
-_NOT_FOR_IMU_DEVICE = ("tilt", "noise", "noise_density", "accel_noise_density")
+_NOT_FOR_IMU_DEVICE = ("tilt", "noise", "noise_density", "accel_noise_density", "temp_points", "temp_ramp")
 
 
 def refuse_device_flags(ctx: typer.Context) -> None:

@@ -36,39 +36,73 @@ def multi_position(model, gyro_kw, flags: dict, sample_rate, rng, settings):
 
     density = 0.002 if flags["accel_noise_density"] is None else flags["accel_noise_density"]
     at_least("accel_noise_density", density, 0.0, " m/s^2/sqrt(Hz)")
+    if flags["temp_points"] is not None and flags["temp_ramp"] is not None:
+        raise InputError("--temp-points (plateaus) and --temp-ramp (a ramp) are two chamber sessions; give one")
+    if flags["temp_ramp"] is not None:
+        return _chamber(model, gyro_kw, flags, density * math.sqrt(sample_rate), sample_rate, rng, settings,
+                        ramp=flags["temp_ramp"])
     if flags["temp_points"] is not None:
         return _chamber(model, gyro_kw, flags, density * math.sqrt(sample_rate), sample_rate, rng, settings)
     for name in ("temp_soak", "temp_hysteresis", "temp_noise"):
         if flags[name] != {"temp_soak": 600.0}.get(name, 0.0):
-            raise InputError(f"--{name.replace('_', '-')} describes a chamber session; add --temp-points T1,T2,..")
+            raise InputError(f"--{name.replace('_', '-')} describes a chamber session; add --temp-points T1,T2,.. "
+                             "or --temp-ramp LOW:HIGH")
     rec, gyro, facts, extra = hand_session(model, gyro_kw=gyro_kw, poses=flags["poses"], tilt_deg=flags["tilt"],
                                            still=flags["still"], accel_noise_std=density * math.sqrt(sample_rate),
                                            misalignment_deg=flags["misalignment"], sample_rate=sample_rate, rng=rng)
     settings.update(extra)
     return rec, gyro, facts
 
-def _chamber(model, gyro_kw, flags: dict, accel_sd: float, sample_rate, rng, settings):
-    """A chamber session (:func:`gyrocal.simulation.chamber.chamber_session`): recording, gyro at 25 degC, facts."""
+def _ramp_flag(text: str) -> tuple[float, float, float]:
+    """LOW:HIGH[:RATE] of --temp-ramp [degC, degC/min]."""
+    from ..simulation.ramp import DEFAULT_RATE
+
+    form = f"--temp-ramp takes LOW:HIGH or LOW:HIGH:RATE [degC, degC/min], e.g. -25:60:1, got {text!r}"
+    try:
+        parts = [float(v) for v in text.split(":")]
+    except ValueError:
+        raise InputError(form) from None
+    if len(parts) not in (2, 3) or not all(map(math.isfinite, parts)):
+        raise InputError(form)
+    rate = parts[2] if len(parts) == 3 else DEFAULT_RATE
+    if not rate > 0:
+        raise InputError(f"--temp-ramp's RATE must be > 0 degC/min, got {rate:g}")
+    return parts[0], parts[1], rate
+
+
+def _chamber(model, gyro_kw, flags: dict, accel_sd: float, sample_rate, rng, settings, ramp: str | None = None):
+    """A chamber session on plateaus (:func:`gyrocal.simulation.chamber.chamber_session`) or on a ramp
+    (:func:`gyrocal.simulation.ramp.ramp_session`): recording, gyro at 25 degC, facts."""
     import numpy as np
 
     from .._validation import at_least, positive
     from ..models import Affine
     from ..simulation.chamber import chamber_session, random_thermal_imu
+    from ..simulation.ramp import ramp_session
 
-    temps = numbers("--temp-points", flags["temp_points"])
+    ends = _ramp_flag(ramp) if ramp is not None else None
+    temps = numbers("--temp-points", flags["temp_points"]) if ramp is None else None
     positive("static_duration", flags["still"])
     at_least("temp_soak", flags["temp_soak"], 0.0, " s")
     at_least("temp_hysteresis", flags["temp_hysteresis"], 0.0, " m/s^2")
+    if ramp is not None and flags["temp_soak"] != 600.0:
+        raise InputError("--temp-soak is the unrecorded soak between plateaus; a --temp-ramp has none")
     truth = random_thermal_imu(model, rng, misalignment_deg=flags["misalignment"],
                                hysteresis=flags["temp_hysteresis"])
-    rec, points = chamber_session(truth, temps, gyro_kw=gyro_kw, poses=flags["poses"], tilt_deg=flags["tilt"],
-                                  still=flags["still"], soak=flags["temp_soak"], accel_noise_std=accel_sd,
-                                  temp_noise=flags["temp_noise"], sample_rate=sample_rate, rng=rng)
+    kw = dict(gyro_kw=gyro_kw, poses=flags["poses"], tilt_deg=flags["tilt"], still=flags["still"],
+              accel_noise_std=accel_sd, temp_noise=flags["temp_noise"], sample_rate=sample_rate, rng=rng)
+    if ramp is None:
+        rec, points = chamber_session(truth, temps, soak=flags["temp_soak"], **kw)
+        chamber = {"temp_points_degC": temps, "temp_soak_s": flags["temp_soak"]}
+        facts = {"imu_thermal": {**truth.to_dict(), "points": points}}
+    else:
+        rec, facts = ramp_session(truth, *ends, **kw)
+        chamber = {"temp_ramp": {"low_degC": ends[0], "high_degC": ends[1], "rate_degC_per_min": ends[2]}}
+        facts = {"imu_thermal": {**truth.to_dict(), "ramp": facts}}
     _, gyro = truth.params(truth.ref_temp)
     settings.update(poses=flags["poses"], tilt_deg=flags["tilt"], still_s=flags["still"], accel_noise_std=accel_sd,
-                    misalignment_deg=flags["misalignment"], temp_points_degC=temps, temp_soak_s=flags["temp_soak"],
+                    misalignment_deg=flags["misalignment"], **chamber,
                     temp_hysteresis_m_s2=flags["temp_hysteresis"], temp_noise_degC=flags["temp_noise"])
-    facts = {"imu_thermal": {**truth.to_dict(), "points": points}}
     return rec, Affine(K=np.linalg.inv(gyro[:9].reshape(3, 3)), B=gyro[9:]), facts
 
 

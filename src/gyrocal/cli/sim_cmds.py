@@ -36,7 +36,7 @@ _PROTOCOL_FLAGS = {
     **dict.fromkeys(("temps", "rates", "step_duration"), ("turntable",)),
     "temp_noise": ("turntable", "static", "multi-position"),
     "temp_quantum": ("turntable", "static"),
-    **dict.fromkeys(("temp_points", "temp_soak", "temp_hysteresis"), ("multi-position",)),
+    **dict.fromkeys(("temp_points", "temp_soak", "temp_hysteresis", "temp_ramp"), ("multi-position",)),
     **dict.fromkeys(("profile", "profile_units"), ("profile",)),
     "duration": ("profile", "static"),
     **dict.fromkeys(("temp_start", "temp_end", "warmup_tau", "bias_tempco", "accel_random_walk"), ("static",)),
@@ -95,6 +95,10 @@ def simulate(
     temp_hysteresis: Annotated[float, typer.Option(
         "--temp-hysteresis", help="--temp-points: accelerometer offsets of a point colder than the one before (the "
                                   "cooling branch) off the heating branch, sign drawn per axis [m/s^2].")] = 0.0,
+    temp_ramp: Annotated[Optional[str], typer.Option(
+        "--temp-ramp", help="--protocol multi-position: a chamber session on a ramp, LOW:HIGH[:RATE] [degC, degC/min], "
+                            "the poses repeated while the temperature drifts, e.g. -25:60 (default: none; RATE "
+                            "1 degC/min; HIGH below LOW cools).")] = None,
     profile: Annotated[Optional[Path], typer.Option("--profile", help="--protocol profile: CSV of t,wx,wy,wz (required there).")] = None,
     profile_units: Annotated[str, typer.Option("--profile-units", help="Unit of the profile rates.")] = "rad/s",
     duration: Annotated[Optional[float], typer.Option(

@@ -167,8 +167,16 @@ def _thermal(rec: Recording, t, kw, sensor_lag=None) -> tuple[ImuThermalResult |
     point nearest 25 degC (the file's correction); a span that gives no model is said in that result's warnings."""
     if rec.temp is None or np.ptp(rec.temp) <= THERMAL_SPAN:
         return None, None
+    from .ramp import calibrate_ramp, is_ramp
+    from .thermal_limits import die_temperature
+
+    ramp = is_ramp(t, rec.temp, kw["breaks"])
     try:
-        thermal = calibrate_imu_thermal(t, rec.gyro, rec.accel, rec.temp, sensor_lag=sensor_lag, **kw)
+        if ramp:  # each pose at its own temperature: the lagging readings moved to the die's, sample by sample
+            temp = rec.temp if not sensor_lag else die_temperature(t, rec.temp, sensor_lag)
+            thermal = calibrate_ramp(t, rec.gyro, rec.accel, temp, **kw)
+        else:
+            thermal = calibrate_imu_thermal(t, rec.gyro, rec.accel, rec.temp, sensor_lag=sensor_lag, **kw)
     except InputError as exc:
         result = calibrate_imu(t, rec.gyro, rec.accel, **kw)
         why = (f"the temperature column spans {np.ptp(rec.temp):.1f} degC but no model in temperature was fitted "
@@ -176,10 +184,21 @@ def _thermal(rec: Recording, t, kw, sensor_lag=None) -> tuple[ImuThermalResult |
         return None, replace(result, warnings=result.warnings + (why,))
     ref = thermal.points[thermal.reference]
     result = max(ref.results, key=lambda r: len(r.statics))
-    what = (f"{len(thermal.points)} temperature points ({', '.join(f'{p.temperature:.1f}' for p in thermal.points)} "
-            f"degC): the correction is the point at {ref.temperature:.1f} degC, accelerometer.thermal holds both "
-            "sensors at every point and their models in temperature")
+    what = _what(thermal, ref, ramp)
     return thermal, replace(result, warnings=result.warnings + thermal.notes + (what,))
+
+
+def _what(thermal: ImuThermalResult, ref, ramp: bool) -> str:
+    """The line that says how the log was read across temperature: a ramp or plateaus, the points, the correction."""
+    temps = ", ".join(f"{p.temperature:.1f}" for p in thermal.points)
+    if not ramp:
+        return (f"temperature plateaus: {len(thermal.points)} temperature points ({temps} degC): the correction is "
+                f"the point at {ref.temperature:.1f} degC, accelerometer.thermal holds both sensors at every point and "
+                "their models in temperature")
+    return (f"a temperature ramp ({thermal.ramp['poses']} poses, each at its own temperature; the accelerometer fitted "
+            f"across them, the gyro in {len(thermal.points)} temperature bins at {temps} degC): the correction is the "
+            f"bin at {ref.temperature:.1f} degC, whose accelerometer fit also holds the drift across the bin (its "
+            "residuals above the noise); accelerometer.thermal holds both sensors' models in temperature")
 
 
 def _gyro_model(result: ImuCalibrationResult):

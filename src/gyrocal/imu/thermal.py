@@ -179,7 +179,8 @@ def _point(group: list[tuple[Plateau, ImuCalibrationResult]], sides: list[str], 
 def calibrate_imu_thermal(t, gyro, accel, temp, *, gravity: float = STANDARD_GRAVITY, accel_model="auto",
                           gyro_model="auto", min_static: float = 1.0, gaps=(), breaks=(), threshold=None,
                           tol: float = 1.0, min_plateau: float = 30.0, max_order: int = 3,
-                          sensor_lag: float | None = None) -> ImuThermalResult:
+                          sensor_lag: float | None = None, plateaus: list[Plateau] | None = None
+                          ) -> ImuThermalResult:
     """Calibrate both sensors at each temperature point of a chamber log and model them in temperature.
 
     Parameters
@@ -194,6 +195,9 @@ def calibrate_imu_thermal(t, gyro, accel, temp, *, gravity: float = STANDARD_GRA
         Highest order of the smooth polynomial tried.
     sensor_lag : float, optional
         Time constant [s] of a temperature sensor that lags the die (:func:`~gyrocal.imu.thermal_limits.lag_corrected`).
+    plateaus : list of Plateau, optional
+        The parts of the log to calibrate on their own (a ramp's temperature bins,
+        :func:`~gyrocal.imu.ramp.ramp_bins`); default :func:`~gyrocal.imu.plateaus.find_plateaus`.
 
     Raises
     ------
@@ -205,8 +209,9 @@ def calibrate_imu_thermal(t, gyro, accel, temp, *, gravity: float = STANDARD_GRA
           "threshold": threshold}
     fitted, notes = [], []
     temp = np.asarray(temp, dtype=float)
-    for plateau in lag_corrected(t, temp, find_plateaus(t, temp, breaks=breaks, tol=tol, min_duration=min_plateau),
-                                 sensor_lag):
+    if plateaus is None:
+        plateaus = find_plateaus(t, temp, breaks=breaks, tol=tol, min_duration=min_plateau)
+    for plateau in lag_corrected(t, temp, plateaus, sensor_lag):
         try:
             fitted.append((plateau, _fit_plateau(t, gyro, accel, plateau, gaps, kw)))
         except (DegenerateDesignError, SegmentationError) as exc:

@@ -32,7 +32,7 @@ import numpy as np
 from .._chi2 import chi2_sf
 from .plateaus import Plateau
 
-__all__ = ["DRIFT_LIMIT", "DRIFT_Z", "HYSTERESIS_P", "Drift", "Hysteresis", "Limits", "assess", "branches",
+__all__ = ["DRIFT_LIMIT", "DRIFT_Z", "HYSTERESIS_P", "Drift", "Hysteresis", "Limits", "assess", "branches", "die_temperature",
            "hysteresis", "lag_corrected", "plateau_drift", "too_few_poses"]
 
 #: Branches whose difference has a chi-square p-value below this are flagged as hysteresis.
@@ -326,3 +326,18 @@ def lag_corrected(t, temp, plateaus: list[Plateau], tau: float | None) -> list[P
     if not tau:
         return plateaus
     return [replace(p, temperature=p.temperature + tau * plateau_drift(t, temp, p).rate) for p in plateaus]
+
+
+def die_temperature(t, temp, tau: float, window: float = 60.0) -> np.ndarray:
+    """Readings (N,) moved to the die's temperature for a sensor lagging it by `tau` [s]: each plus `tau` times
+    the readings' local slope, a least-squares line over `window` seconds centred on it (a first-order lag
+    ``dT_s/dt = (T_die - T_s) / tau``)."""
+    t, temp = np.asarray(t, dtype=float), np.asarray(temp, dtype=float)
+    x = t - t.mean()
+    lo = np.searchsorted(t, t - window / 2)
+    hi = np.searchsorted(t, t + window / 2, side="right")
+    sums = [np.concatenate(([0.0], np.cumsum(v))) for v in (np.ones_like(x), x, temp, x * temp, x * x)]
+    n, sx, sy, sxy, sxx = (c[hi] - c[lo] for c in sums)
+    den = n * sxx - sx * sx
+    slope = np.divide(n * sxy - sx * sy, den, out=np.zeros_like(den), where=den > 0)
+    return temp + tau * slope

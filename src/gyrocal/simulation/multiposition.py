@@ -28,7 +28,7 @@ from ..units import STANDARD_GRAVITY
 from .gyro import VirtualGyro
 
 __all__ = ["ImuSession", "MultiPositionProtocol", "VirtualImu", "hand_session", "mounted_gyro", "random_accelerometer",
-           "session_facts", "session_recording", "simulate_multi_position"]
+           "session_facts", "session_motion", "session_recording", "simulate_multi_position"]
 
 
 @dataclass(frozen=True)
@@ -233,6 +233,25 @@ def _kinematics(t: np.ndarray, segs: list[tuple]) -> tuple[np.ndarray, np.ndarra
     return q, axis * sd[:, None], axis * sdd[:, None]
 
 
+def session_motion(q_poses: np.ndarray, p: MultiPositionProtocol, rng: np.random.Generator):
+    """The true motion of a session through poses `q_poses` (n, 4): sample times (N,) [s], body rates (N, 3)
+    [rad/s] (the Earth's rotation included), specific force (N, 3) [m/s^2] at the lever arm, and the still
+    spans (n, 2) of the poses (sample indices)."""
+    segs = _segments(q_poses, p, rng)
+    end = segs[-1][0] + segs[-1][1]
+    t = _times(end, p.sample_rate, p.uneven_steps, rng)
+    q, w, alpha = _kinematics(t, segs)
+    r = np.asarray(p.lever_arm, dtype=float)
+    f = quat.rotate(q * [1, -1, -1, -1], p.gravity * _poses.UP)
+    f = f + np.cross(alpha, r) + np.cross(w, np.cross(w, r))
+    if p.latitude_deg is not None:
+        lat = np.radians(p.latitude_deg)
+        w = w + quat.rotate(q * [1, -1, -1, -1], EARTH_RATE * np.array([0.0, np.cos(lat), np.sin(lat)]))
+    still = np.array([[np.searchsorted(t, s[0], side="left"), np.searchsorted(t, s[0] + s[1], side="right")]
+                      for s in segs if s[4] == 0.0])
+    return t, w, f, still
+
+
 def simulate_multi_position(imu: VirtualImu, protocol: MultiPositionProtocol | None = None, *,
                             rng: np.random.Generator) -> ImuSession:
     """Simulate a hand multi-position session.
@@ -250,20 +269,9 @@ def simulate_multi_position(imu: VirtualImu, protocol: MultiPositionProtocol | N
     """
     p = protocol or MultiPositionProtocol()
     q_poses = p.pose_orientations(rng)
-    segs = _segments(q_poses, p, rng)
-    end = segs[-1][0] + segs[-1][1]
-    t = _times(end, p.sample_rate, p.uneven_steps, rng)
-    q, w, alpha = _kinematics(t, segs)
-    r = np.asarray(p.lever_arm, dtype=float)
-    f = quat.rotate(q * [1, -1, -1, -1], p.gravity * _poses.UP)
-    f = f + np.cross(alpha, r) + np.cross(w, np.cross(w, r))
-    if p.latitude_deg is not None:
-        lat = np.radians(p.latitude_deg)
-        w = w + quat.rotate(q * [1, -1, -1, -1], EARTH_RATE * np.array([0.0, np.cos(lat), np.sin(lat)]))
+    t, w, f, still = session_motion(q_poses, p, rng)
     gyro = imu.gyro.measure(w, p.sample_rate, rng) + f @ imu.g_sensitivity.T
     accel = imu.accel(f, rng)
-    still = np.array([[np.searchsorted(t, s[0], side="left"), np.searchsorted(t, s[0] + s[1], side="right")]
-                      for s in segs if s[4] == 0.0])
     aff = imu.gyro.model.to_affine()
     truth = {"accel_matrix": imu.accel_matrix.copy(), "accel_offset": imu.accel_offset.copy(),
              "gyro_matrix": np.linalg.inv(aff.K), "gyro_offset": np.array(aff.B),
