@@ -30,15 +30,15 @@ import time
 #: What ``import gyrocal.cli`` loaded before the lazy imports: the package root's names and the command
 #: modules' top-level imports.
 PREVIOUS = ("import numpy; import gyrocal.calibration, gyrocal.estimators, gyrocal.models, gyrocal.observations, "
-            "gyrocal.recording, gyrocal.segmentation, gyrocal.units, gyrocal.windows, gyrocal.cli.app; "
-            "gyrocal.cli.app.load_all(); ")
+            "gyrocal.recording, gyrocal.segmentation, gyrocal.units, gyrocal.windows; "
+            "from gyrocal.cli.app import load_all; load_all(); ")
 RUN = "import gyrocal.cli, sys; sys.argv = ['gyrocal'] + {argv!r}; gyrocal.cli.main()"
 
 
 def once(code: str, src: str | None = None) -> float:
     env = None if src is None else dict(os.environ, PYTHONPATH=src)
     t0 = time.perf_counter()
-    subprocess.run([sys.executable, "-c", code], capture_output=True, check=False, env=env)
+    subprocess.run([sys.executable, "-c", code], capture_output=True, check=True, env=env)
     return time.perf_counter() - t0
 
 

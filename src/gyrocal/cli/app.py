@@ -84,18 +84,24 @@ class _Typer(typer.Typer):
 
 
 def _build(name: str):
-    """The click command (or group) `name` from its registration, importing its module; None if unknown."""
+    """The click command (or group) `name` from its registration, importing its module; None if unknown.
+    Its parameters convert ordinary values in plain Python (:mod:`gyrocal.cli._coerce`)."""
+    from ._coerce import install
+
     importlib.import_module(f"{__package__}.{COMMANDS[name]}")
+    cmd = None
     for info in app.__dict__["_registered_commands"]:
         if (info.name or typer.main.get_command_name(info.callback.__name__)) == name:
-            return typer.main.get_command_from_info(info, pretty_exceptions_short=app.pretty_exceptions_short,
-                                                    rich_markup_mode=app.rich_markup_mode)
+            cmd = typer.main.get_command_from_info(info, pretty_exceptions_short=app.pretty_exceptions_short,
+                                                   rich_markup_mode=app.rich_markup_mode)
     for info in app.__dict__["_registered_groups"]:
         if info.name == name:
-            return typer.main.get_group_from_info(info, pretty_exceptions_short=app.pretty_exceptions_short,
-                                                  rich_markup_mode=app.rich_markup_mode,
-                                                  suggest_commands=app.suggest_commands)
-    return None
+            cmd = typer.main.get_group_from_info(info, pretty_exceptions_short=app.pretty_exceptions_short,
+                                                 rich_markup_mode=app.rich_markup_mode,
+                                                 suggest_commands=app.suggest_commands)
+    if cmd is not None:
+        install(cmd)
+    return cmd
 
 
 class _Interrupted(BaseException):
@@ -122,8 +128,13 @@ class _OrderedGroup(TyperGroup):
         return cmd
 
     def _add_all(self) -> None:
+        from ._coerce import install
+
         load_all()
-        self.commands.update({k: v for k, v in typer.main.get_group(app).commands.items() if k not in self.commands})
+        new = {k: v for k, v in typer.main.get_group(app).commands.items() if k not in self.commands}
+        for cmd in new.values():
+            install(cmd)
+        self.commands.update(new)
 
     def invoke(self, ctx):
         try:
@@ -261,7 +272,11 @@ def _click_command():
     """The click group typer builds from :data:`app`, with the commands registered so far (the others are
     built when asked for): built once, as typer would rebuild it for every run in the same process (tests
     run hundreds)."""
-    return typer.main.get_command(app)
+    from ._coerce import install
+
+    group = typer.main.get_command(app)
+    install(group)
+    return group
 
 
 def run(argv: list[str] | None = None) -> int:
