@@ -83,15 +83,20 @@ class _Typer(typer.Typer):
     registered_groups = _Registered()
 
 
-def _build(name: str):
-    """The click command (or group) `name` from its registration, importing its module; None if unknown.
-    Its parameters convert ordinary values in plain Python (:mod:`gyrocal.cli._coerce`)."""
+def _name(info) -> str:
+    return info.name or typer.main.get_command_name(info.callback.__name__)
+
+
+def _build(name: str, module: str | None = None):
+    """The click command (or group) `name` from its registration, importing `module` (default: its module
+    in :data:`COMMANDS`); None if unknown. Its parameters convert ordinary values in plain Python
+    (:mod:`gyrocal.cli._coerce`)."""
     from ._coerce import install
 
-    importlib.import_module(f"{__package__}.{COMMANDS[name]}")
+    importlib.import_module(f"{__package__}.{module or COMMANDS[name]}")
     cmd = None
     for info in app.__dict__["_registered_commands"]:
-        if (info.name or typer.main.get_command_name(info.callback.__name__)) == name:
+        if _name(info) == name:
             cmd = typer.main.get_command_from_info(info, pretty_exceptions_short=app.pretty_exceptions_short,
                                                    rich_markup_mode=app.rich_markup_mode)
     for info in app.__dict__["_registered_groups"]:
@@ -128,13 +133,14 @@ class _OrderedGroup(TyperGroup):
         return cmd
 
     def _add_all(self) -> None:
-        from ._coerce import install
-
         load_all()
-        new = {k: v for k, v in typer.main.get_group(app).commands.items() if k not in self.commands}
-        for cmd in new.values():
-            install(cmd)
-        self.commands.update(new)
+        registered = [(_name(i), i.callback.__module__) for i in app.__dict__["_registered_commands"]]
+        registered += [(i.name, __name__) for i in app.__dict__["_registered_groups"]]
+        for name, module in registered:
+            if name not in self.commands:
+                cmd = _build(name, COMMANDS.get(name, module.rsplit(".", 1)[-1]))
+                if cmd is not None:
+                    self.commands[name] = cmd
 
     def invoke(self, ctx):
         try:
