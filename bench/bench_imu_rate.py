@@ -1,13 +1,16 @@
 """``gyrocal imu`` CPU against the sample rate, and the gyro fit's Jacobian against a finite difference.
 
-Run by hand:  python bench/bench_imu_rate.py [--rates 200,1000,2000] [--repeat 3]
+Run by hand:  python bench/bench_imu_rate.py [--rates 200,1000,2000] [--repeat 3] [--previous-src DIR]
 
 * Whole command: ``gyrocal simulate --protocol multi-position --sample-rate R -o s.csv --seed 1`` once per
   rate, then ``gyrocal imu s.csv --units deg/s --accel-units m/s^2 -o i.json`` in fresh processes; the
   CPU (user + system) of each, median of --repeat, interleaved across rates. Baseline: the 1 kHz run
-  (issue 25: 2 kHz at most 2.3x the CPU of 1 kHz).
-* The fit alone, in this process, on a simulated session at the highest rate: ``calibrate_imu`` with
-  the analytic Jacobian and with the central-difference one (its baseline), process CPU time.
+  (issue 25: 2 kHz at most 2.3x the CPU of 1 kHz). With ``--previous-src``, the same commands of an
+  earlier gyrocal (``git worktree add /tmp/old 2db7693``, then ``--previous-src /tmp/old/src``),
+  interleaved, and previous / now.
+* The fit alone, in this process, on a simulated 24-pose session at the highest rate: ``calibrate_imu``
+  with the analytic Jacobian and with a central difference in its place (two integrations of the
+  attitudes per parameter, for every Jacobian; its baseline), process CPU time.
 """
 
 from __future__ import annotations
@@ -23,28 +26,32 @@ import time
 from pathlib import Path
 
 
-def _cpu_of(cmd: list[str]) -> float:
+def _cpu_of(cmd: list[str], src: str | None = None) -> float:
+    env = None if src is None else dict(os.environ, PYTHONPATH=src)
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    subprocess.run(cmd, check=True, capture_output=True)
+    subprocess.run(cmd, check=True, capture_output=True, env=env)
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
-def whole_command(rates: list[int], repeat: int, folder: Path) -> None:
+def whole_command(rates: list[int], repeat: int, folder: Path, previous: str | None) -> None:
     gyrocal = [sys.executable, "-m", "gyrocal"]
     for r in rates:
         subprocess.run(gyrocal + ["simulate", "--protocol", "multi-position", "--sample-rate", str(r), "--seed", "1",
                                   "-o", str(folder / f"s{r}.csv"), "--force"], check=True, capture_output=True)
-    cpu = {r: [] for r in rates}
+    cpu = {(r, src): [] for r in rates for src in ([None, previous] if previous else [None])}
     for _ in range(repeat):
-        for r in rates:
-            cpu[r].append(_cpu_of(gyrocal + ["imu", str(folder / f"s{r}.csv"), "--units", "deg/s", "--accel-units",
-                                             "m/s^2", "-o", str(folder / f"i{r}.json"), "--force"]))
-    base = statistics.median(cpu[1000]) if 1000 in cpu else None
+        for r, src in cpu:
+            cpu[r, src].append(_cpu_of(gyrocal + ["imu", str(folder / f"s{r}.csv"), "--units", "deg/s",
+                                                  "--accel-units", "m/s^2", "-o", str(folder / f"i{r}.json"),
+                                                  "--force"], src))
+    med = {k: statistics.median(v) for k, v in cpu.items()}
     for r in rates:
-        med = statistics.median(cpu[r])
-        ratio = f"; / 1 kHz {med / base:.2f}x" if base else ""
-        print(f"gyrocal imu at {r:>5} Hz: CPU {med:.2f} s (median of {repeat}){ratio}")
+        ratio = f"; / 1 kHz {med[r, None] / med[1000, None]:.2f}x" if 1000 in rates else ""
+        if previous:
+            ratio += (f"; previous {med[r, previous]:.2f} s (/ 1 kHz {med[r, previous] / med[1000, previous]:.2f}x), "
+                      f"previous / now {med[r, previous] / med[r, None]:.2f}x" if 1000 in rates else "")
+        print(f"gyrocal imu at {r:>5} Hz: CPU {med[r, None]:.2f} s (median of {repeat}){ratio}")
 
 
 def fit_alone(rate: int, repeat: int) -> None:
@@ -83,11 +90,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rates", default="200,1000,2000")
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--previous-src", help="src folder of an earlier gyrocal, run as the baseline")
     args = parser.parse_args()
     rates = [int(r) for r in args.rates.split(",")]
     os.environ.setdefault("PYTHONPATH", str(Path(__file__).resolve().parents[1] / "src"))
     with tempfile.TemporaryDirectory() as tmp:
-        whole_command(rates, args.repeat, Path(tmp))
+        whole_command(rates, args.repeat, Path(tmp), args.previous_src)
     fit_alone(max(rates), args.repeat)
 
 

@@ -68,22 +68,39 @@ def prefix_products(m: np.ndarray) -> np.ndarray:
     return x.reshape(n_int, blocks * size, 3, 3)[:, :length]
 
 
-def _padded(prob: GyroProblem, omega: np.ndarray):
-    """Each pair's motion samples as rows of (P, L + 1): times (held at the last one after the end, so
-    padded steps last no time), rates (zero after the end), the index into the concatenation, and
-    the mask (P, L + 1, 1) of real samples."""
-    steps = prob.bounds[:, 1] - prob.bounds[:, 0]
+def _padded(bounds: np.ndarray, prob: GyroProblem, omega: np.ndarray):
+    """The motion samples of the pairs of `bounds` as rows of (P, L + 1): times (held at the last one
+    after the end, so padded steps last no time), rates (zero after the end), the index into the
+    concatenation, and the mask (P, L + 1, 1) of real samples."""
+    steps = bounds[:, 1] - bounds[:, 0]
     cols = np.arange(int(steps.max(initial=0)) + 1)
     valid = cols[None, :] <= steps[:, None]
-    idx = np.minimum(prob.bounds[:, :1] + cols[None, :], prob.bounds[:, 1:])
+    idx = np.minimum(bounds[:, :1] + cols[None, :], bounds[:, 1:])
     t = prob.t_cat[idx]
     keep = valid[..., None]
     return t, np.where(keep, omega[idx], 0.0), idx, keep
 
 
 def _pair_theta(prob: GyroProblem, a, b, g, with_g: bool):
-    """Attitude change of each pair (P, 3, 3) and ``d theta / d params`` (P, 3, 12 or 21)."""
-    t, w, idx, keep = _padded(prob, prob.omega_params(a, b, g))
+    """Attitude change of each pair (P, 3, 3) and ``d theta / d params`` (P, 3, 12 or 21).
+
+    Pairs are taken in groups of similar length (by the power of two above it), so that padding
+    at most doubles the work and the memory, as in :func:`gyrocal.quaternion.attitude_matrices`.
+    """
+    omega = prob.omega_params(a, b, g)
+    steps = prob.bounds[:, 1] - prob.bounds[:, 0]
+    group = np.ceil(np.log2(np.maximum(steps, 1))).astype(int)
+    rot = np.broadcast_to(np.eye(3), (len(steps), 3, 3)).copy()
+    dtheta = np.zeros((len(steps), 3, 21 if with_g else 12))
+    for k in np.unique(group):
+        members = np.flatnonzero(group == k)
+        rot[members], dtheta[members] = _group_theta(prob.bounds[members], prob, omega, a, b, g, with_g)
+    return rot, dtheta
+
+
+def _group_theta(bounds, prob: GyroProblem, omega, a, b, g, with_g: bool):
+    """:func:`_pair_theta` of the pairs of `bounds`."""
+    t, w, idx, keep = _padded(bounds, prob, omega)
     h = np.diff(t, axis=1)[..., None]
     w0, w1 = w[:, :-1], w[:, 1:]
     phi = h * 0.5 * (w0 + w1) + (h * h / 12.0) * np.cross(w0, w1)
