@@ -1,8 +1,10 @@
 """Start-up cost of the command line: ``gyrocal --help`` and ``gyrocal calibrate --example``.
 
-Run by hand:  python bench/bench_startup.py [--repeat 5] [--previous-src DIR]
+Run by hand:  python bench/bench_startup.py [--repeat 9] [--previous-src DIR]
 
-Each command runs in a fresh interpreter (best of `repeat`), next to:
+Each command runs in a fresh interpreter, `repeat` times, interleaved with its baselines (so load on a
+shared machine reaches all alike); the figures are medians, and the ratios medians of the paired ratios.
+The baselines:
 
 * the bare interpreter (``python -c pass``): the floor no import can beat;
 * ``python -c "import numpy"``: the baseline of issue 25 (``calibrate --example`` at most 2.5x it);
@@ -11,13 +13,16 @@ Each command runs in a fresh interpreter (best of `repeat`), next to:
   the top), kept here as the baseline; or, with ``--previous-src``, a checkout of an earlier gyrocal
   itself (``git worktree add /tmp/old c8f2222`` then ``--previous-src /tmp/old/src``).
 
-Prints each time, the share of it that is interpreter start, and previous / now.
+Prints each time, the share of it that is interpreter start, previous / now and now / import numpy.
+The command line imports only the module of the command it runs (``gyrocal.cli.app``); the previous
+start without ``--previous-src`` imports every command module first (``gyrocal.cli.app.load_all``).
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import statistics
 import subprocess
 import sys
 import time
@@ -25,34 +30,44 @@ import time
 #: What ``import gyrocal.cli`` loaded before the lazy imports: the package root's names and the command
 #: modules' top-level imports.
 PREVIOUS = ("import numpy; import gyrocal.calibration, gyrocal.estimators, gyrocal.models, gyrocal.observations, "
-            "gyrocal.recording, gyrocal.segmentation, gyrocal.units, gyrocal.segmentation.windows; ")
+            "gyrocal.recording, gyrocal.segmentation, gyrocal.units, gyrocal.segmentation.windows; "
+            "from gyrocal.cli.app import load_all; load_all(); ")
 RUN = "import gyrocal.cli, sys; sys.argv = ['gyrocal'] + {argv!r}; gyrocal.cli.main()"
 
 
-def best(code: str, repeat: int, src: str | None = None) -> float:
+def once(code: str, src: str | None = None) -> float:
     env = None if src is None else dict(os.environ, PYTHONPATH=src)
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        subprocess.run([sys.executable, "-c", code], capture_output=True, check=False, env=env)
-        times.append(time.perf_counter() - t0)
-    return min(times)
+    t0 = time.perf_counter()
+    subprocess.run([sys.executable, "-c", code], capture_output=True, check=True, env=env)
+    return time.perf_counter() - t0
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--repeat", type=int, default=9)
     parser.add_argument("--previous-src", help="src folder of an earlier gyrocal, run as the baseline")
     args = parser.parse_args()
-    floor, numpy_start = best("pass", args.repeat), best("import numpy", args.repeat)
-    print(f"interpreter alone: {floor:.3f} s, with numpy imported {numpy_start:.3f} s")
+    runs = {"floor": ("pass", None), "numpy": ("import numpy", None)}
     for argv in (["--help"], ["calibrate", "--example"]):
-        now = best(RUN.format(argv=argv), args.repeat)
-        before = (best(RUN.format(argv=argv), args.repeat, args.previous_src) if args.previous_src
-                  else best(PREVIOUS + RUN.format(argv=argv), args.repeat))
         name = "gyrocal " + " ".join(argv)
-        print(f"{name:>28}: now {now:.3f} s ({100 * floor / now:.0f} % interpreter), previous {before:.3f} s; "
-              f"previous / now {before / now:.2f}x; now / import numpy {now / numpy_start:.2f}x")
+        runs[name] = (RUN.format(argv=argv), None)
+        runs[name + " previous"] = ((RUN.format(argv=argv), args.previous_src) if args.previous_src
+                                    else (PREVIOUS + RUN.format(argv=argv), None))
+    times = {k: [] for k in runs}
+    for _ in range(args.repeat):
+        for k, (code, src) in runs.items():
+            times[k].append(once(code, src))
+    med = {k: statistics.median(v) for k, v in times.items()}
+
+    def paired(a: str, b: str) -> float:
+        return statistics.median(x / y for x, y in zip(times[a], times[b]))
+
+    print(f"interpreter alone: {med['floor']:.3f} s, with numpy imported {med['numpy']:.3f} s "
+          f"(medians of {args.repeat}, interleaved)")
+    for name in ("gyrocal --help", "gyrocal calibrate --example"):
+        print(f"{name:>28}: now {med[name]:.3f} s ({100 * med['floor'] / med[name]:.0f} % interpreter), previous "
+              f"{med[name + ' previous']:.3f} s; previous / now {paired(name + ' previous', name):.2f}x; "
+              f"now / import numpy {paired(name, 'numpy'):.2f}x")
 
 
 if __name__ == "__main__":

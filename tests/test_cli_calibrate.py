@@ -450,3 +450,16 @@ def test_a_windows_file_without_turns_is_told_to_add_them(tmp_path):
     (tmp_path / "w.json").write_text(json.dumps([{"start": 0, "stop": 300, "kind": "static"}]))
     line = refused("calibrate", tmp_path / "s.csv", "--units", "deg/s", "--windows", tmp_path / "w.json")
     assert "add the missing rotation windows to the windows file (--windows)" in line
+
+
+@pytest.mark.parametrize("speed", ["abc", "60furlongs/s"])
+def test_example_with_a_speed_that_is_not_one_is_refused_in_one_line(speed):
+    """Reference: the one-line refusal contract (exit 2, no traceback), with the bundled example's own flags."""
+    line = refused("calibrate", "--example", "--speed", speed)
+    assert "--speed" in line
+
+
+def test_example_with_a_speed_written_with_its_unit_runs():
+    code, out, err = invoke("calibrate", "--example", "--speed", "60deg/s")
+    assert code == 0, err
+    assert "--speed 60deg/s" in out

@@ -7,8 +7,7 @@ so ``import gyrocal`` (and ``gyrocal --help``) does not pay for numpy.
 
 from __future__ import annotations
 
-import importlib
-
+from ._lazy import lazy_names
 from ._moved import install as _install_moved
 from ._version import __version__
 
@@ -41,13 +40,4 @@ _EXPORTS = {
 __all__ = ["__version__", *_EXPORTS]
 
 
-def __getattr__(name: str):
-    if name not in _EXPORTS:
-        raise AttributeError(f"module 'gyrocal' has no attribute {name!r}")
-    value = getattr(importlib.import_module(f".{_EXPORTS[name]}", __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_EXPORTS))
+__getattr__, __dir__ = lazy_names(__name__, _EXPORTS, globals())

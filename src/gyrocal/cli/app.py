@@ -2,12 +2,18 @@
 
 Command modules register on :data:`app`. Library errors become one line on stderr
 and exit code 2; ``--debug`` shows the traceback instead.
+
+A run imports only the module of the command it runs and builds only that command's click
+parameters (:data:`COMMANDS` names each command's module): start-up is then the cost of one
+command, not of all of them. ``gyrocal --help``, an unknown command, and anything that reads
+:data:`app`'s commands outside a run (tests, a library user) import every command module.
 """
 
 from __future__ import annotations
 
 import contextlib
 import functools
+import importlib
 import os
 import sys
 import warnings
@@ -29,6 +35,78 @@ from ._flags import flag
 
 #: Commands in the order ``gyrocal --help`` lists them; set once, in ``gyrocal.cli``.
 HELP_ORDER: list[str] = []
+#: Every module of ``gyrocal.cli`` that registers commands; set once, in ``gyrocal.cli``.
+MODULES: list[str] = []
+#: Command (or command group) name -> the module that registers it; set once, in ``gyrocal.cli``.
+COMMANDS: dict[str, str] = {}
+#: ``lazy``: inside :func:`run` (reading the commands imports nothing); ``loading``, ``complete``: of
+#: :func:`load_all`.
+_registry = {"lazy": 0, "loading": False, "complete": False}
+
+
+def load_all() -> None:
+    """Import every command module (each registers its commands on :data:`app`)."""
+    if _registry["loading"] or _registry["complete"] or not MODULES:
+        return
+    _registry["loading"] = True
+    try:
+        for name in MODULES:
+            importlib.import_module(f"{__package__}.{name}")
+        _registry["complete"] = True
+    finally:
+        _registry["loading"] = False
+
+
+class _Registered:
+    """One of typer's lists of registrations (commands, groups), kept as ``_<name>`` on the instance: read
+    outside :func:`run`, it first imports every command module; inside a run, or while :func:`load_all`
+    imports them (the decorators append to it), it imports nothing."""
+
+    def __set_name__(self, owner, name) -> None:
+        self.key = f"_{name}"
+
+    def __get__(self, obj, owner=None):
+        if obj is None:
+            return self
+        if not _registry["lazy"]:
+            load_all()
+        return obj.__dict__[self.key]
+
+    def __set__(self, obj, value) -> None:
+        obj.__dict__[self.key] = value
+
+
+class _Typer(typer.Typer):
+    """typer's application whose registered commands, read outside :func:`run`, are every command."""
+
+    registered_commands = _Registered()
+    registered_groups = _Registered()
+
+
+def _name(info) -> str:
+    return info.name or typer.main.get_command_name(info.callback.__name__)
+
+
+def _build(name: str, module: str | None = None):
+    """The click command (or group) `name` from its registration, importing `module` (default: its module
+    in :data:`COMMANDS`); None if unknown. Its parameters convert ordinary values in plain Python
+    (:mod:`gyrocal.cli._coerce`)."""
+    from ._coerce import install
+
+    importlib.import_module(f"{__package__}.{module or COMMANDS[name]}")
+    cmd = None
+    for info in app.__dict__["_registered_commands"]:
+        if _name(info) == name:
+            cmd = typer.main.get_command_from_info(info, pretty_exceptions_short=app.pretty_exceptions_short,
+                                                   rich_markup_mode=app.rich_markup_mode)
+    for info in app.__dict__["_registered_groups"]:
+        if info.name == name:
+            cmd = typer.main.get_group_from_info(info, pretty_exceptions_short=app.pretty_exceptions_short,
+                                                 rich_markup_mode=app.rich_markup_mode,
+                                                 suggest_commands=app.suggest_commands)
+    if cmd is not None:
+        install(cmd)
+    return cmd
 
 
 class _Interrupted(BaseException):
@@ -38,7 +116,31 @@ class _Interrupted(BaseException):
 
 class _OrderedGroup(TyperGroup):
     """Lists commands in :data:`HELP_ORDER`, then any others by name, each with its whole first sentence;
-    Ctrl-C inside a command reaches :func:`run` (as :class:`_Interrupted`)."""
+    builds a command when it is first asked for (:func:`_build`); Ctrl-C inside a command reaches
+    :func:`run` (as :class:`_Interrupted`)."""
+
+    def get_command(self, ctx, cmd_name):
+        cmd = self.commands.get(cmd_name)
+        if cmd is None and cmd_name in COMMANDS:
+            cmd = _build(cmd_name)
+        elif cmd is None:
+            # unknown here: a command of a module missing from COMMANDS, or a typo (whose suggestions
+            # need every name)
+            self._add_all()
+            cmd = self.commands.get(cmd_name)
+        if cmd is not None:
+            self.commands[cmd_name] = cmd
+        return cmd
+
+    def _add_all(self) -> None:
+        load_all()
+        registered = [(_name(i), i.callback.__module__) for i in app.__dict__["_registered_commands"]]
+        registered += [(i.name, __name__) for i in app.__dict__["_registered_groups"]]
+        for name, module in registered:
+            if name not in self.commands:
+                cmd = _build(name, COMMANDS.get(name, module.rsplit(".", 1)[-1]))
+                if cmd is not None:
+                    self.commands[name] = cmd
 
     def invoke(self, ctx):
         try:
@@ -47,6 +149,7 @@ class _OrderedGroup(TyperGroup):
             raise _Interrupted from exc
 
     def list_commands(self, ctx):
+        self._add_all()
         names = super().list_commands(ctx)
         rank = {name: i for i, name in enumerate(HELP_ORDER)}
         return sorted(names, key=lambda n: (rank.get(n, len(rank)), n))
@@ -62,7 +165,7 @@ class _OrderedGroup(TyperGroup):
                 formatter.write_dl(rows)
 
 
-app = typer.Typer(
+app = _Typer(
     name="gyrocal",
     cls=_OrderedGroup,
     help="Calibrate triaxial MEMS gyroscopes: servo-aided and full-temperature-range methods.",
@@ -172,15 +275,28 @@ def message(exc: BaseException) -> str:
 
 @functools.cache
 def _click_command():
-    """The click command typer builds from :data:`app` (every command registers at import): built once, as
-    typer would rebuild it for every run in the same process (tests run hundreds)."""
-    return typer.main.get_command(app)
+    """The click group typer builds from :data:`app`, with the commands registered so far (the others are
+    built when asked for): built once, as typer would rebuild it for every run in the same process (tests
+    run hundreds)."""
+    from ._coerce import install
+
+    group = typer.main.get_command(app)
+    install(group)
+    return group
 
 
 def run(argv: list[str] | None = None) -> int:
     """Run the CLI; map library, OS and usage errors to one line and exit code 2."""
     if argv is not None and not argv:
         argv = ["--help"]  # bare 'gyrocal' is a request for help, not a mistake
+    _registry["lazy"] += 1
+    try:
+        return _run(argv)
+    finally:
+        _registry["lazy"] -= 1
+
+
+def _run(argv: list[str] | None) -> int:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("always", GyrocalWarning)
@@ -212,7 +328,7 @@ def run(argv: list[str] | None = None) -> int:
 
 def _command_path(argv: list[str] | None) -> str:
     """``gyrocal NAME`` for the first word of `argv` that names a command, else ``gyrocal``."""
-    names = {c.name or c.callback.__name__.replace("_", "-") for c in app.registered_commands}
+    names = set(COMMANDS) | {c.name or c.callback.__name__.replace("_", "-") for c in app.registered_commands}
     word = next((a for a in argv or () if a in names), None)
     return f"gyrocal {word}" if word else "gyrocal"
 

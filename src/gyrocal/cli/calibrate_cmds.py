@@ -221,9 +221,9 @@ def calibrate(
         recording, truth_path = _example_paths()
         units = units or "deg/s"
         if speed is None and angle is None and windows is None:
-            speed = EXAMPLE_SPEED
+            speed = f"{EXAMPLE_SPEED:g}"
         intro = (f"example: {recording}\n  same as: gyrocal calibrate {recording} --units deg/s "
-                 + (f"--speed {speed:g}" if speed is not None else f"--angle {360 if angle is None else angle:g}"))
+                 + (f"--speed {speed}" if speed is not None else f"--angle {360 if angle is None else angle:g}"))
     if recording is None:
         raise InputError("give a recording to calibrate (or --example for the bundled one)")
     units, read_notes = required_units(units), []

@@ -9,9 +9,10 @@ from scipy.optimize import least_squares
 from ..errors import DegenerateDesignError
 from . import _fit
 from ._gyro_cov import noise_model, whitener
+from ._gyro_jac import residual_jacobian
 from ._gyro_problem import GyroProblem
 
-__all__ = ["MASKS", "initial_scale", "jacobian", "residuals", "screen_pairs", "solve", "unpack"]
+__all__ = ["MASKS", "initial_scale", "jacobian", "residuals", "residuals_jacobian", "screen_pairs", "solve", "unpack"]
 
 MASKS = {"affine": np.ones((3, 3), dtype=bool), "scale": np.eye(3, dtype=bool)}
 #: Re-weighting rounds of the equation groups (variance-component estimation).
@@ -31,6 +32,12 @@ def residuals(prob: GyroProblem, model, with_g, p, directions, directions_std):
     a, b, g = unpack(model, with_g, p)
     return np.concatenate([prob.static_residuals(b, g), prob.pair_residuals(a, b, g, directions, directions_std),
                            prob.turn_residuals(a, b, g)])
+
+
+def residuals_jacobian(prob: GyroProblem, model, with_g, p, directions, directions_std):
+    """``d residuals / d p`` of :func:`residuals`, analytic (:mod:`gyrocal.imu._gyro_jac`): one integration
+    of the attitudes, where a finite difference takes two per parameter."""
+    return residual_jacobian(prob, MASKS[model], with_g, *unpack(model, with_g, p), directions, directions_std)
 
 
 def jacobian(fun, p: np.ndarray) -> np.ndarray:
@@ -87,12 +94,15 @@ def solve(prob, model, with_g, p0, accel, means):
     def raw(q):
         return residuals(prob, model, with_g, q, d, d_std)
 
+    def raw_jac(q):
+        return residuals_jacobian(prob, model, with_g, q, d, d_std)
+
     def fit(q):
         s = noise_model(prob, unpack(model, with_g, q), accel, means)
         w = whitener(s)
-        q = least_squares(lambda x: w @ raw(x), q, method="lm", x_scale="jac", xtol=1e-12, ftol=1e-12,
-                          gtol=1e-12, max_nfev=2000).x
-        return q, w @ raw(q), w @ jacobian(raw, q), s
+        q = least_squares(lambda x: w @ raw(x), q, jac=lambda x: w @ raw_jac(x), method="lm", x_scale="jac",
+                          xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=2000).x
+        return q, w @ raw(q), w @ raw_jac(q), s
 
     p, r, jac, s = fit(p0)
     for _ in range(_VCE_ITER):
@@ -122,6 +132,9 @@ def screen_pairs(prob: GyroProblem, p0, directions, directions_std) -> np.ndarra
     def fun(q):
         return residuals(prob, "affine", False, q, directions, directions_std)
 
+    def jac(q):
+        return residuals_jacobian(prob, "affine", False, q, directions, directions_std)
+
     def pair_chi2(q):
         r = fun(q)[n_static:n_static + 2 * n_pairs].reshape(-1, 2)
         return np.einsum("ij,ij->i", r, r)
@@ -129,8 +142,8 @@ def screen_pairs(prob: GyroProblem, p0, directions, directions_std) -> np.ndarra
     def robust_scale2(chi2):
         return max(1.0, float(np.median(chi2)) / stats.chi2.ppf(0.5, 2))
 
-    p = least_squares(fun, p0, method="trf", x_scale="jac").x
-    p = least_squares(fun, p, method="trf", x_scale="jac", loss="cauchy",
+    p = least_squares(fun, p0, jac=jac, method="trf", x_scale="jac").x
+    p = least_squares(fun, p, jac=jac, method="trf", x_scale="jac", loss="cauchy",
                       f_scale=3.0 * np.sqrt(robust_scale2(pair_chi2(p)))).x
     chi2 = pair_chi2(p)
     keep = chi2 / robust_scale2(chi2) < stats.chi2.isf(OUTLIER_P, 2)

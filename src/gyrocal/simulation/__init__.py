@@ -9,14 +9,17 @@ Layer 8 (firmware, exports, simulation, figures and the store) of docs/architect
 root and layers 1 to 8 only, and not export, firmware, io, jobs, plotting, store, thermal.
 """
 
-from .fast import simulate_observations
-from .gyro import ThermalErrors, VirtualGyro, noise_std_from_density
-from .profiles import simulate_profile
-from .servo import ServoProtocol, simulate_servo
-from .still import BiasDrift, StillAccelerometer, StillProtocol, simulate_still
-from .thermal_truth import ThermalTruth
-from .turntable import TurntableProtocol, simulate_turntable
-from .windows import paper_observations
+from .._lazy import lazy_names
+
+#: Public name -> module of this package that defines it; loaded on first use, so that importing one
+#: simulator (``gyrocal.simulation.truth`` for the bundled example) does not import them all.
+_EXPORTS = {
+    "simulate_observations": "fast", "ThermalErrors": "gyro", "VirtualGyro": "gyro",
+    "noise_std_from_density": "gyro", "simulate_profile": "profiles", "ServoProtocol": "servo",
+    "simulate_servo": "servo", "BiasDrift": "still", "StillAccelerometer": "still", "StillProtocol": "still",
+    "simulate_still": "still", "ThermalTruth": "thermal_truth", "TurntableProtocol": "turntable",
+    "simulate_turntable": "turntable", "paper_observations": "windows",
+}
 
 __all__ = [
     "VirtualGyro", "ThermalErrors", "noise_std_from_density",
@@ -25,3 +28,6 @@ __all__ = [
     "simulate_profile", "paper_observations", "simulate_observations",
     "BiasDrift", "StillAccelerometer", "StillProtocol", "simulate_still",
 ]
+
+
+__getattr__, __dir__ = lazy_names(__name__, _EXPORTS, globals())
