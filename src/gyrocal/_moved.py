@@ -9,9 +9,8 @@ the new paths only (``tests/test_layers.py``).
 from __future__ import annotations
 
 import importlib
-import importlib.abc
-import importlib.util
 import sys
+from importlib.machinery import ModuleSpec
 
 #: Old module -> new module.
 MOVED = {
@@ -48,13 +47,14 @@ MOVED = {
 }
 
 
-class _Alias(importlib.abc.MetaPathFinder, importlib.abc.Loader):
-    """Finds an old name and hands out the module at its new place."""
+class _Alias:
+    """Finds an old name and hands out the module at its new place (a meta path finder and its loader; the
+    protocol is duck-typed, which keeps ``importlib.abc`` and its imports out of ``import gyrocal``)."""
 
     def find_spec(self, name, path=None, target=None):
         if name not in MOVED:
             return None
-        return importlib.util.spec_from_loader(name, self)
+        return ModuleSpec(name, self)
 
     def create_module(self, spec):
         module = importlib.import_module(MOVED[spec.name])
