@@ -3,10 +3,13 @@
 Many IMUs report temperature in coarse steps (1 degC, 0.5 degC). Block means of such
 readings are a staircase: off by up to half a step for minutes while the board warms
 slowly, and a bias slope turns that into a bias error. Smoothing in time cannot remove a
-step that lasts longer than the filter. But the instant a (median-filtered) reading moves
-from one level to the next is the instant the true temperature crossed the midpoint
-between them, so the course is known exactly there; gyrocal interpolates between those
-crossings with a monotone cubic (PCHIP). Outside the first and last crossing the
+step that lasts longer than the filter. But the instant a reading moves from one level to
+the next is the instant the true temperature crossed the midpoint between them, so the
+course is known there. The crossings are found on median-filtered half-second blocks, then
+each one's time is counted from the raw readings around it to a fraction of a sample
+(:func:`_refine`: a steep offset turns the blocks' time error, a good part of a block, into
+an error of its curve larger than the noise's); gyrocal interpolates between the crossings
+with a monotone cubic (PCHIP). Outside the first and last crossing the
 temperature is only known to within half a step, so those samples are marked invalid.
 Fine-grained readings are only lightly averaged (a zero-phase filter of 2 s).
 """
@@ -24,6 +27,8 @@ __all__ = ["TemperatureCourse", "temperature_course"]
 
 #: Readings taking fewer distinct values than one per this many samples count as quantised.
 _SAMPLES_PER_LEVEL = 50
+#: A crossing's window reaches this many crossings either way (readings past the midpoint counted in it).
+_REACH = 2
 
 
 @dataclass(frozen=True)
@@ -57,20 +62,72 @@ def _quantum(readings: np.ndarray) -> float | None:
     return q if on_grid.all() else None
 
 
-def _crossings(level: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Times (sample index) and temperatures of the level changes, chatter merged."""
+def _crossings(level: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Times (block index), temperatures and directions (+1 up, -1 down, 0 a touch) of the level changes.
+
+    Back-and-forth across one midpoint is one crossing, at the mean time; its direction is the net
+    change (0 where the level comes back to where it was).
+    """
     idx = np.flatnonzero(np.diff(level) != 0)
     mid = 0.5 * (level[idx] + level[idx + 1])
-    times, temps = [], []
+    times, temps, signs = [], [], []
     i = 0
-    while i < len(idx):  # back-and-forth across one midpoint is one crossing, at the mean time
+    while i < len(idx):
         j = i
         while j + 1 < len(idx) and mid[j + 1] == mid[i]:
             j += 1
         times.append(0.5 * (idx[i] + idx[j]) + 0.5)
         temps.append(mid[i])
+        signs.append(np.sign(level[idx[j] + 1] - level[idx[i]]))
         i = j + 1
-    return np.array(times), np.array(temps)
+    return np.array(times), np.array(temps), np.array(signs)
+
+
+def _refine(r: np.ndarray, times: np.ndarray, temps: np.ndarray, signs: np.ndarray, q: float) -> np.ndarray:
+    """Crossing times (sample index) to a fraction of a sample, from the raw readings around each.
+
+    A reading rounds to a level above the midpoint ``m`` exactly when the true temperature plus the
+    reading noise exceeds ``m``, so the probability of a reading past ``m`` is the noise's CDF at
+    ``T(t) - m``. Over a window ``[a, b)`` that starts well before the crossing and ends well after,
+    the count of readings past ``m`` is then ``b - t_c`` in expectation (exactly where ``T`` is
+    straight and the noise symmetric), whatever the noise: ``t_c = b - count - 1/2`` for samples at
+    integer times. Each window reaches `_REACH` crossings (that many steps) either way, so the
+    reading noise's tails at its ends are a step or more from ``m`` (:func:`_window`). The block medians'
+    crossing times err by a good part of a block (their 0.5 s resolution and the running median's
+    response to chatter), which a steep offset turns into an error of the fitted curve.
+    """
+    n = len(r)
+    out = times.astype(float)
+    for k in np.flatnonzero(signs != 0):
+        window = _window(times, temps, signs, q, k)
+        if window is None:
+            continue
+        a, b = (int(np.clip(round(e), 0, n)) for e in window)
+        past = np.count_nonzero(signs[k] * (r[a:b] - temps[k]) > 0)
+        out[k] = min(max(b - past - 0.5, a), b)
+    return out
+
+
+def _window(times, temps, signs, q: float, k: int) -> tuple[float, float] | None:
+    """Start and end (sample index) of crossing `k`'s window, out to `_REACH` crossings either way.
+
+    Only as far as the course runs one way, a step of `q` per crossing (a re-crossing of
+    ``temps[k]`` must stay out); a window with no crossing on one side reaches as far there as on
+    the other. None where neither side has one: that crossing keeps the block medians' time.
+    """
+    def steady(j: int) -> bool:
+        return signs[j] == signs[k] and abs(temps[j] - temps[k] - signs[k] * (j - k) * q) < 1e-6 * q
+
+    lo = k
+    while lo > max(k - _REACH, 0) and steady(lo - 1):
+        lo -= 1
+    hi = k
+    while hi < min(k + _REACH, len(times) - 1) and steady(hi + 1):
+        hi += 1
+    if lo == hi:
+        return None
+    reach = max(times[k] - times[lo], times[hi] - times[k])
+    return (times[lo] if lo < k else times[k] - reach), (times[hi] if hi > k else times[k] + reach)
 
 
 def temperature_course(readings, sample_rate: float, *, median_s: float = 5.0) -> TemperatureCourse:
@@ -99,11 +156,11 @@ def temperature_course(readings, sample_rate: float, *, median_s: float = 5.0) -
     blocks = np.median(r[: nb * size].reshape(nb, size), axis=1) if nb else r[:1]
     blocks = r.min() + np.round((blocks - r.min()) / q) * q  # an even count's median may fall between levels
     level = median_filter(blocks, size=max(3, int(round(median_s / 0.5))) | 1, mode="nearest")
-    times, temps = _crossings(level)
-    times = times * size  # block boundaries in samples
+    times, temps, signs = _crossings(level)
     if len(times) < 2:
         raise InputError(f"the temperature readings (steps of {q:g} degC) change level fewer than twice; the log "
                          "does not warm enough to fit a bias against temperature")
+    times = _refine(r, times * size, temps, signs, q)  # block boundaries in samples, then sub-sample
     n = np.arange(len(r))
     valid = (n >= times[0]) & (n <= times[-1])
     temp = np.full(len(r), np.nan)
