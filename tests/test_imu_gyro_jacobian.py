@@ -9,7 +9,11 @@ References, none of which uses the analytic derivative:
   within what that finite difference resolves.
 """
 
+from importlib import resources
+from pathlib import Path
+
 import numpy as np
+import pandas as pd
 import pytest
 
 import gyrocal.imu._gyro_solve as solve_mod
@@ -18,6 +22,7 @@ from gyrocal import quaternion as quat
 from gyrocal.imu import calibrate_imu
 from gyrocal.imu._gyro_jac import prefix_products, right_jacobian
 from gyrocal.imu._gyro_solve import MASKS, jacobian, residuals, residuals_jacobian
+from gyrocal.io import read_windows
 from gyrocal.models import Affine
 from gyrocal.simulation.gyro import VirtualGyro
 from gyrocal.simulation.multiposition import MultiPositionProtocol, VirtualImu, simulate_multi_position
@@ -32,10 +37,9 @@ def _session(seed):
                                                               uneven_steps=0.03), rng=rng)
 
 
-@pytest.fixture(scope="module")
-def captured():
-    """The gyro problem of a simulated session, as :func:`gyrocal.imu.gyro.fit_gyroscope` builds it."""
-    s = _session(7)
+def _capture(*args, **kwargs):
+    """The gyro problem and accelerometer fit that :func:`gyrocal.imu.gyro.fit_gyroscope` builds for
+    ``calibrate_imu(*args, **kwargs)``, and the calibration."""
     seen = {}
     real = gyro_mod.solve
 
@@ -45,10 +49,28 @@ def captured():
 
     gyro_mod.solve = spy
     try:
-        result = calibrate_imu(s.t, s.gyro, s.accel)
+        result = calibrate_imu(*args, **kwargs)
     finally:
         gyro_mod.solve = real
     return seen["args"] + (result,)
+
+
+@pytest.fixture(scope="module")
+def captured():
+    """The gyro problem of a simulated session, as :func:`gyrocal.imu.gyro.fit_gyroscope` builds it."""
+    s = _session(7)
+    return _capture(s.t, s.gyro, s.accel)
+
+
+@pytest.fixture(scope="module")
+def captured_turns():
+    """The gyro problem of imucal's Ferraris session: poses and three known-angle turns."""
+    data = Path(str(resources.files("gyrocal") / "data" / "imucal_ferraris"))
+    df = pd.read_csv(data / "example_ferraris_session.csv")
+    fs = 102.4  # Hz, from the session's README
+    windows = read_windows(data / "example_ferraris_session_list.json", sample_rate=fs)
+    return _capture(np.arange(len(df)) / fs, np.radians(df[["gyr_x", "gyr_y", "gyr_z"]].to_numpy()),
+                    df[["acc_x", "acc_y", "acc_z"]].to_numpy(), gravity=9.81, windows=windows)
 
 
 def _five_point(fun, p, rel=1e-3):
@@ -61,11 +83,7 @@ def _five_point(fun, p, rel=1e-3):
     return np.column_stack(cols)
 
 
-@pytest.mark.parametrize("model", ["affine", "scale"])
-@pytest.mark.parametrize("with_g", [False, True])
-def test_jacobian_matches_a_five_point_difference_of_the_residuals(captured, model, with_g):
-    """Away from the optimum, with unequal group factors (they scale each group's noise): every column
-    within 1e-8 of its largest entry (the difference's own error is below 1e-9)."""
+def _check_columns(captured, model, with_g):
     prob, accel, result = captured
     rng = np.random.default_rng(11)
     prob.factors = np.array([1.3, 0.8, 1.7])
@@ -77,6 +95,23 @@ def test_jacobian_matches_a_five_point_difference_of_the_residuals(captured, mod
     assert got.shape == ref.shape
     scale = np.abs(ref).max(axis=0)
     assert np.all(np.abs(got - ref).max(axis=0) <= 1e-8 * scale)
+
+
+@pytest.mark.parametrize("model", ["affine", "scale"])
+@pytest.mark.parametrize("with_g", [False, True])
+def test_jacobian_matches_a_five_point_difference_of_the_residuals(captured, model, with_g):
+    """Away from the optimum, with unequal group factors (they scale each group's noise): every column
+    within 1e-8 of its largest entry (the difference's own error is below 1e-9)."""
+    _check_columns(captured, model, with_g)
+
+
+@pytest.mark.parametrize("with_g", [False, True])
+def test_jacobian_of_known_angle_turns_matches_a_five_point_difference(captured_turns, with_g):
+    """The same check on a session with known-angle turns (their rows, whose noise holds the Earth's rate
+    over each turn's duration): every column within 1e-8 of its largest entry."""
+    prob, _, _ = captured_turns
+    assert len(prob.turns) == 3
+    _check_columns(captured_turns, "affine", with_g)
 
 
 def test_prefix_products_match_a_loop_of_quaternion_products():
@@ -109,6 +144,18 @@ def test_right_jacobian_is_the_derivative_of_the_rotation():
             dr = (quat.rotvec_matrix(phi + dphi) - quat.rotvec_matrix(phi - dphi)) / (2 * h)
             w = r0.T @ dr  # the skew matrix of J_r e_j
             np.testing.assert_allclose([w[2, 1], w[0, 2], w[1, 0]], jr[:, j], atol=1e-8)
+
+
+def test_right_jacobian_series_near_its_switch_against_the_closed_form():
+    """Just below the angle where the small-angle series takes over (|phi| = 9e-3): the closed form written
+    without cancellation, (1 - cos a) / a^2 = 2 sin^2(a/2) / a^2 and (a - sin a) / a^3 (relative error about
+    1e-11 here), to 1e-12 of the identity."""
+    phi = np.array([0.6, -0.48, 0.64]) * 9e-3
+    a = float(np.linalg.norm(phi))
+    c1, c2 = 2 * np.sin(a / 2) ** 2 / a**2, (a - np.sin(a)) / a**3
+    skew = np.array([[0, -phi[2], phi[1]], [phi[2], 0, -phi[0]], [-phi[1], phi[0], 0]])
+    want = np.eye(3) - c1 * skew + c2 * skew @ skew
+    np.testing.assert_allclose(right_jacobian(phi), want, rtol=0, atol=1e-12)
 
 
 def test_fit_reaches_the_finite_difference_fits_optimum_and_covariance(monkeypatch):

@@ -12,6 +12,7 @@ import math
 import numpy as np
 import pytest
 from cli_runner import invoke, refused
+from scipy.stats import binom
 
 from gyrocal.errors import InputError
 from gyrocal.imu.ramp import fit_ramp_accel, is_ramp
@@ -61,20 +62,45 @@ def test_joint_fit_one_sigma_against_the_truth():
     assert abs(np.mean(z)) < 3 / np.sqrt(m)
 
 
+def _linear_board(seed):
+    """The joint fit of a seeded board whose parameters are linear in temperature, 150 poses from -25 to 60 degC."""
+    rng = np.random.default_rng(seed)
+    truth = random_thermal_imu(ScaleBias((1.0, 1.0, 1.0), (0.0, 0.0, 0.0)), rng)
+    linear = truth.accel_coefs.copy()
+    linear[:, 2:] = 0.0
+    truth = type(truth)(linear, truth.gyro_coefs)
+    temps = np.sort(rng.uniform(-25.0, 60.0, 150))
+    return fit_ramp_accel(_poses(truth, temps, rng), np.full((150, 3), SE), temps, "triangular")
+
+
 def test_order_drops_when_the_truth_is_linear():
     """A board whose parameters are linear in temperature: the top powers are found zero (their joint Wald test
     passes with probability 0.95 at each step), so order 1 is chosen on most of 20 boards (expected 18)."""
-    orders = []
-    for seed in range(20):
-        rng = np.random.default_rng(2000 + seed)
-        truth = random_thermal_imu(ScaleBias((1.0, 1.0, 1.0), (0.0, 0.0, 0.0)), rng)
-        linear = truth.accel_coefs.copy()
-        linear[:, 2:] = 0.0
-        truth = type(truth)(linear, truth.gyro_coefs)
-        temps = np.sort(rng.uniform(-25.0, 60.0, 150))
-        orders.append(int(fit_ramp_accel(_poses(truth, temps, rng), np.full((150, 3), SE), temps,
-                                         "triangular").orders.max()))
+    orders = [int(_linear_board(2000 + seed).orders.max()) for seed in range(20)]
     assert sum(o == 1 for o in orders) >= 14, orders
+
+
+@pytest.fixture(scope="module")
+def linear_boards():
+    """300 seeded boards whose parameters are linear in temperature (150 poses each): their fits."""
+    return [_linear_board(3000 + seed) for seed in range(300)]
+
+
+def test_the_wald_rule_keeps_a_zero_cubic_at_its_size(linear_boards):
+    """The true cubic coefficients are zero, so the joint Wald test of the 9 of them (chi-square, 9 dof) keeps
+    the cubic with probability DROP_P = 0.05: the count over 300 boards is Binomial(300, 0.05) (scipy), each
+    tail beyond it at least 1e-3. A test with too many dof or a laxer threshold keeps it far less or more often."""
+    kept = sum(int(f.orders.max()) == 3 for f in linear_boards)
+    assert binom.cdf(kept, 300, 0.05) > 1e-3 and binom.sf(kept - 1, 300, 0.05) > 1e-3, kept
+
+
+def test_the_fit_chi2_is_that_of_the_pose_noise(linear_boards):
+    """Residuals weighted by each pose's noise (the simulated SE) against a truth the fit can follow: the chi2
+    summed over the boards is chi-square with the summed dof, so its ratio to them is within
+    1 +- 3 sqrt(2 / dof) (a pose's variance 10 % off moves it by 0.1, 14 times that band)."""
+    chi2 = sum(f.quality.chi2 for f in linear_boards)
+    dof = sum(f.quality.dof for f in linear_boards)
+    assert abs(chi2 / dof - 1) < 3 * np.sqrt(2 / dof), chi2 / dof
 
 
 def test_few_poses_lower_the_order():

@@ -277,3 +277,61 @@ def test_the_smooth_model_takes_the_lowest_order_within_one_standard_error(monke
     monkeypatch.setattr(smooth, "loto_errors", lambda t, y, top: rms[: top + 1])
     model = smooth.fit_smooth(np.linspace(-40.0, 85.0, n), np.linspace(0.0, 1.0, n)[:, None], max_order=3)
     assert int(model.orders[0]) == order
+
+
+def test_hysteresis_chi2_and_half_width_by_hand():
+    """Reference: one point seen heating (20 degC), then 40, then cooling back to 20; two parameters whose
+    branch difference d = (0.5, -0.1) has covariance C = [[0.004, 0.0005], [0.0005, 0.004]] (the two plateaus'
+    covariances summed). By hand: chi2 = d^T C^-1 d = (0.004 * 0.25 - 2 * 0.0005 * (-0.05) + 0.004 * 0.01) /
+    (0.004^2 - 0.0005^2), 2 dof, p = exp(-chi2 / 2); flagged, so the added variance is the half-width's,
+    (d_j^2 - C_jj) / 4."""
+    from gyrocal.imu.plateaus import Plateau
+    from gyrocal.imu.thermal_limits import hysteresis
+
+    plateaus = [Plateau(0, 10, 20.0, 0.0), Plateau(10, 20, 40.0, 0.0), Plateau(20, 30, 20.0, 0.0)]
+    params = [np.array([1.0, 2.0]), np.array([1.2, 2.2]), np.array([1.5, 1.9])]
+    covs = [np.array([[0.002, 0.001], [0.001, 0.003]]), np.eye(2) * 0.01,
+            np.array([[0.002, -0.0005], [-0.0005, 0.001]])]
+    h = hysteresis([[0, 2], [1]], plateaus, params, covs, ("o_x", "o_y"))
+    want = (0.004 * 0.25 - 2 * 0.0005 * (-0.05) + 0.004 * 0.01) / (0.004**2 - 0.0005**2)
+    assert h.dof == 2 and h.chi2 == pytest.approx(want, rel=1e-9)
+    assert h.p_value == pytest.approx(math.exp(-want / 2), rel=1e-6) and h.flagged
+    np.testing.assert_allclose(h.extra_variance, [(0.25 - 0.004) / 4, (0.01 - 0.004) / 4], rtol=1e-9)
+    np.testing.assert_allclose(h.difference, [0.5, -0.1], rtol=1e-9)
+
+
+def test_mid_branch_join_by_hand():
+    """Reference: the mean of two independent branch values, (p_h + p_c) / 2, has covariance (C_h + C_c) / 4;
+    a point seen heating only moves by half the measured difference, its variance plus std^2 / 4."""
+    from gyrocal.imu.thermal_limits import Hysteresis, Limits
+
+    h = Hysteresis((20.0,), ("o_x", "o_y"), np.array([0.4, -0.2]), np.array([0.02, 0.04]), 50.0, 2, 1e-11,
+                   np.array([0.04, 0.01]))
+    lim = Limits(accelerometer=h, gyro=None, drifts=())
+    ch, cc = np.array([[0.002, 0.001], [0.001, 0.003]]), np.array([[0.004, 0.0], [0.0, 0.001]])
+    value, cov = lim.join("accelerometer", [np.array([1.0, 2.0]), np.array([1.4, 1.8])], [ch, cc],
+                          ["heating", "cooling"])
+    np.testing.assert_allclose(value, [1.2, 1.9], rtol=1e-12)
+    np.testing.assert_allclose(cov, [[0.0015, 0.00025], [0.00025, 0.001]], rtol=1e-12)
+    value, cov = lim.join("accelerometer", [np.array([1.0, 2.0])], [ch], ["heating"])
+    np.testing.assert_allclose(value, [1.2, 1.9], rtol=1e-12)
+    np.testing.assert_allclose(cov, [[0.002 + 0.0001, 0.001], [0.001, 0.003 + 0.0004]], rtol=1e-12)
+
+
+def test_a_misfitting_top_order_is_birge_scaled_by_chi2_over_dof():
+    """Reference: weighted least squares by hand (numpy lstsq) of a quadratic, the highest order 4 points allow,
+    through a cubic that it cannot follow: coefficients' covariance (X^T W X)^-1 times chi2 / dof (1 dof)."""
+    from gyrocal.imu.thermal_model import temperature_model
+
+    nodes = np.array([-20.0, 0.0, 20.0, 40.0])
+    values = (1.0 + 0.01 * nodes + 2e-6 * nodes**3)[:, None]
+    var = np.array([1e-6, 4e-6, 1e-6, 2e-6])
+    model = temperature_model(("k",), nodes, values, var[:, None, None], max_order=3)
+    x = np.vander((nodes - model.smooth.centre) / model.smooth.scale, 3, increasing=True)
+    w = 1.0 / np.sqrt(var)
+    beta, *_ = np.linalg.lstsq(x * w[:, None], values[:, 0] * w, rcond=None)
+    chi2_ = float(np.sum(((values[:, 0] - x @ beta) * w) ** 2))
+    assert chi2.sf(chi2_, 1) < 1e-3  # the misfit is flagged
+    want = np.linalg.inv((x * w[:, None] ** 2).T @ x) * chi2_
+    assert model.smooth.orders[0] == 2 and model.misfit_scale[0] == pytest.approx(chi2_, rel=1e-6)
+    np.testing.assert_allclose(model.smooth_covariance[:3, :3], want, rtol=1e-6)

@@ -11,6 +11,10 @@ Run by hand, not in CI (a survivor costs a full suite run)::
     python tools/mutants.py                 # every mutation, one worker
     python tools/mutants.py -j 2 -k excess  # the mutations whose name contains "excess", two workers
     python tools/mutants.py --list
+    python tools/mutants.py -k ramp --hints-only  # only each mutation's own test files, not the whole suite
+
+With ``--hints-only`` a mutant that its own test files do not kill is reported as ``survived the
+hints`` without the whole-suite run (cheap on a shared machine; a full run decides it).
 
 It exits 1 when any mutant survives, 2 when a mutation no longer matches its module (the list is stale).
 """
@@ -69,8 +73,9 @@ def _first_failure(output: str) -> str:
     return tail[-1] if tail else "no output"
 
 
-def run_one(m: Mutation, python: str) -> Outcome:
-    """Mutate a fresh copy of the tree and run the suite there, the likely killers first."""
+def run_one(m: Mutation, python: str, hints_only: bool = False) -> Outcome:
+    """Mutate a fresh copy of the tree and run the suite there, the likely killers first (only them with
+    `hints_only`, when the mutation names any)."""
     with tempfile.TemporaryDirectory(prefix="gyrocal-mutant-") as tmp:
         tree = Path(tmp)
         _tracked_copy(tree)
@@ -82,13 +87,15 @@ def run_one(m: Mutation, python: str) -> Outcome:
         # pytest orders one run's files by folder, so the likely killers get a run of their own first
         # tests that signal a process at a moment in time check no statistics, and a loaded machine upsets them
         everything = ["tests", "-k", "not ctrl_c and not sigterm"]
-        for selection in ([*m.tests], everything) if m.tests else (everything,):
+        selections = ([*m.tests],) if m.tests and hints_only else ([*m.tests], everything) if m.tests else (everything,)
+        for selection in selections:
             proc = subprocess.run(cmd + selection, cwd=tree, env=env, capture_output=True, text=True)
             if proc.returncode:
                 break
         seconds = time.perf_counter() - start
     out = proc.stdout + proc.stderr
-    return Outcome(m, proc.returncode != 0, _first_failure(out) if proc.returncode else "survived", seconds)
+    survived = "survived the hints" if m.tests and hints_only else "survived"
+    return Outcome(m, proc.returncode != 0, _first_failure(out) if proc.returncode else survived, seconds)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -96,6 +103,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("-k", dest="match", default="", help="only mutations whose name contains this")
     parser.add_argument("-j", dest="jobs", type=int, default=1, help="mutants run at once")
     parser.add_argument("--list", action="store_true", help="print the mutations and stop")
+    parser.add_argument("--hints-only", action="store_true",
+                        help="run only each mutation's own test files, not the whole suite after them")
     parser.add_argument("--python", default=sys.executable, help="the interpreter that has the test extras")
     args = parser.parse_args(argv)
     chosen = [m for m in MUTATIONS if args.match in m.name]
@@ -110,7 +119,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"{len(chosen)} mutations, {args.jobs} at a time")
     with ThreadPoolExecutor(args.jobs) as pool:
         outcomes = []
-        for o in pool.map(lambda m: run_one(m, args.python), chosen):
+        for o in pool.map(lambda m: run_one(m, args.python, args.hints_only), chosen):
             outcomes.append(o)
             print(f"{'killed  ' if o.killed else 'SURVIVED'} {o.mutation.name:32s} {o.seconds:6.0f} s  {o.by}",
                   flush=True)

@@ -23,6 +23,12 @@ class Mutation:
 S = "src/gyrocal/"
 FM = S + "estimators/first_moment.py"
 EX6 = S + "estimators/_exact6.py"
+RAMP, LIM, TM, GJ = (S + "imu/" + f for f in ("ramp.py", "thermal_limits.py", "thermal_model.py", "_gyro_jac.py"))
+IMU_RAMP = ("tests/test_imu_ramp.py",)
+IMU_LIM = ("tests/test_imu_thermal_limits.py", "tests/test_imu_thermal_sim.py")
+PIN_LIM = ("tests/test_pins.py",) + IMU_LIM
+IMU_TM = ("tests/test_pins.py", "tests/test_imu_thermal.py", "tests/test_imu_thermal_sim.py", "tests/test_imu_thermal_limits.py")
+GJ_TESTS = ("tests/test_imu_gyro_jacobian.py",)
 SEL = ("tests/test_pins.py", "tests/test_selfcheck.py", "tests/test_realistic.py", "tests/test_estimators.py")
 MUTATIONS = [
     # estimators: the first-moment rows, weights and sandwich covariance
@@ -170,6 +176,44 @@ MUTATIONS = [
     # the station's verdict: the guard band
     Mutation("guard-band", S + "station/accept.py", "reach = self.guard * self.sigma",
              "reach = self.sigma", "the guard band's factor dropped", ("tests/test_station_accept.py",)),
+    # the whole IMU across temperature: the ramp's joint accelerometer fit
+    Mutation("ramp-order-error", RAMP, "covariance=cov + np.outer(d, d)", "covariance=cov",
+             "a ramp's lower order chosen without its model error d d^T", IMU_RAMP),
+    Mutation("ramp-wald-dof", RAMP, "stats.chi2.sf(wald, prob.m)", "stats.chi2.sf(wald, 2 * prob.m)",
+             "the top power's Wald test with twice its degrees of freedom", IMU_RAMP),
+    Mutation("ramp-drop-p", RAMP, "DROP_P = 0.05", "DROP_P = 0.5", "the top power kept unless p < 0.5", IMU_RAMP),
+    Mutation("ramp-offset-jacobian", RAMP, "d_q = np.column_stack([d_a, -np.einsum(",
+             "d_q = np.column_stack([d_a, np.einsum(", "the offset's Jacobian columns with the wrong sign", IMU_RAMP),
+    Mutation("ramp-pose-sigma", RAMP, "np.einsum(\"pi,pij->pj\", n, a) ** 2, self.se**2))",
+             "np.einsum(\"pi,pij->pj\", n, a) ** 2, self.se**2 * 1.1))", "a pose's variance 10 % high", IMU_RAMP),
+    # the limits of a chamber calibration: hysteresis and a lagging temperature sensor
+    Mutation("hysteresis-half-width", LIM, "extra = h2 / 4 if", "extra = h2 if",
+             "the full, not half, hysteresis width in the 1-sigma", IMU_LIM),
+    Mutation("hysteresis-noise-removed", LIM, "(w * (d**2 - var)).sum(axis=0)", "(w * d**2).sum(axis=0)",
+             "the branches' noise left in the hysteresis width", PIN_LIM),
+    Mutation("hysteresis-chi2-diagonal", LIM, "chi2 = float(sum(x @ np.linalg.solve(v, x) for",
+             "chi2 = float(sum(x @ (x / np.diag(v)) for", "the branches' chi-square without the correlations",
+             PIN_LIM),
+    Mutation("hysteresis-mid-branch", LIM, "return (ph + pc) / 2, (ch + cc) / 4",
+             "return (ph + pc) / 2, (ch + cc) / 2", "the mid-branch value's variance not a quarter", PIN_LIM),
+    Mutation("drift-slope-sd", LIM, "resid @ resid / max(len(y) - 2, 1) / sxx", "resid @ resid / max(len(y) - 2, 1)",
+             "a plateau's drift z against the readings' sd, not the slope's", IMU_LIM),
+    Mutation("die-slope", LIM, "den = n * sxx - sx * sx", "den = n * sxx",
+             "the die's local slope with the window's mean of t not removed", IMU_RAMP + IMU_LIM),
+    # the IMU's temperature model on plateaus: Birge scaling and the order choice
+    Mutation("imu-birge-not-rooted", TM, "s = np.repeat(np.sqrt(scale), coefs.shape[1])",
+             "s = np.repeat(scale, coefs.shape[1])", "a misfitting top order's variance times (chi2/dof)^2", IMU_TM),
+    Mutation("imu-order-error", TM, "cov = cov * np.outer(s, s) + _order_error(", "cov = cov * np.outer(s, s) + 0 * _order_error(",
+             "a lower order chosen without its model error d d^T", IMU_TM),
+    # the gyro fit's analytic Jacobian (its covariance uses it)
+    Mutation("gyro-jac-sigma", GJ, "(prob.lrv * w2 / (3 * sd**2))", "(prob.lrv * w2 / (2 * sd**2))",
+             "the noise's derivative in A with 1/2, not 1/3, of the mean squared diagonal", GJ_TESTS),
+    Mutation("gyro-jac-coning", GJ, "m[:, 1:] += half * v + cone * np.cross(", "m[:, 1:] += half * v - cone * np.cross(",
+             "the coning term's derivative in the later rate with the wrong sign", GJ_TESTS),
+    Mutation("gyro-jac-earth", GJ, "+ (EARTH_RATE * prob.turn_time) ** 2 / 3)", "+ (EARTH_RATE * prob.turn_time) ** 2 / 6)",
+             "a turn's Earth-rate variance halved in the Jacobian's weights", GJ_TESTS),
+    Mutation("gyro-jac-series", GJ, "0.5 - a2 / 24 + a2**2 / 720", "0.5 - a2 / 12 + a2**2 / 720",
+             "the right Jacobian's small-angle series with a2/12", GJ_TESTS),
     # the C library's window accumulator and closed form
     Mutation("c-accum-var", S + "c/gyrocal_cal.c", "float var = (acc->s2[i] + acc->c2[i]) / n - m1 * m1;",
              "float var = (acc->s2[i] + acc->c2[i]) / n;", "C: variance without the mean's square",
