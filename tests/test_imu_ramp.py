@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from cli_runner import invoke, refused
 from scipy.stats import binom
+from thermal_sessions import smooth_at, truth_params
 
 from gyrocal.errors import InputError
 from gyrocal.imu.ramp import fit_ramp_accel, is_ramp
@@ -160,20 +161,6 @@ def ramp_cli(tmp_path_factory):
     return d, out + err, truth, load(d / "cal.json").accelerometer["thermal"]
 
 
-def _truth_params(doc, sensor, temps):
-    x = (np.asarray(temps) - doc["ref_temp_degC"]) / doc["scale_degC"]
-    return np.vander(x, 4, increasing=True) @ np.asarray(doc[sensor]["coefs"]).T
-
-
-def _smooth(doc, temps):
-    sm = doc["smooth"]
-    coefs = np.asarray(sm["coefs"])
-    m, width = coefs.shape
-    powers = np.vander((np.asarray(temps) - sm["centre"]) / sm["scale"], width, increasing=True)
-    cov = np.asarray(sm["covariance"]).reshape(m, width, m, width)
-    return powers @ coefs.T, np.sqrt(np.einsum("np,jpjq,nq->nj", powers, cov, powers))
-
-
 def test_cli_ramp_says_so_and_writes_the_section(ramp_cli):
     """The output says the log was a ramp and flags poses whose temperature moves over 0.5 degC (10 degC/min,
     3 s +- 25 % poses: 0.4 to 0.6 degC); the section has the ramp and points spanning the poses' range."""
@@ -191,8 +178,8 @@ def test_cli_ramp_accelerometer_against_the_sidecar(ramp_cli):
     cubics (63 z-scores; a normal one exceeds 4.5 with probability 7e-6)."""
     _, _, truth, section = ramp_cli
     temps = np.linspace(-24.0, 59.0, 7)
-    value, sigma = _smooth(section["accelerometer"], temps)
-    z = (value - _truth_params(truth, "accelerometer", temps)[:, _LOWER]) / sigma
+    value, sigma = smooth_at(section["accelerometer"], temps)
+    z = (value - truth_params(truth, "accelerometer", temps)[:, _LOWER]) / sigma
     assert np.abs(z).max() < 4.5, z
 
 

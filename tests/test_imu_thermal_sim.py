@@ -10,6 +10,7 @@ import json
 import numpy as np
 import pytest
 from cli_runner import invoke, refused
+from thermal_sessions import smooth_at, truth_params
 
 from gyrocal.imu.planning import predict_poses
 from gyrocal.imu.thermal import calibrate_imu_thermal
@@ -22,22 +23,6 @@ TEMPS = np.linspace(-25.0, 50.0, 5)
 MID = (TEMPS[1:] + TEMPS[:-1]) / 2
 FS, POSES, STILL, ACCEL_DENSITY = 100.0, 12, 2.0, 2e-3
 _LOWER = np.r_[np.nonzero(np.tril(np.ones((3, 3), bool)).ravel())[0], 9, 10, 11]  # the 9-parameter model's
-
-
-def _truth_params(doc, sensor, temps):
-    """Parameters (N, 12) of `sensor` from the sidecar's cubics at `temps` [degC] (heating branch)."""
-    x = (np.asarray(temps) - doc["ref_temp_degC"]) / doc["scale_degC"]
-    return np.vander(x, 4, increasing=True) @ np.asarray(doc[sensor]["coefs"]).T
-
-
-def _smooth(doc, temps):
-    """Values and 1-sigma (N, m) of a file's smooth model (``accelerometer.thermal.<sensor>``) at `temps`."""
-    sm = doc["smooth"]
-    coefs = np.asarray(sm["coefs"])
-    m, width = coefs.shape
-    powers = np.vander((np.asarray(temps) - sm["centre"]) / sm["scale"], width, increasing=True)
-    cov = np.asarray(sm["covariance"]).reshape(m, width, m, width)
-    return powers @ coefs.T, np.sqrt(np.einsum("np,jpjq,nq->nj", powers, cov, powers))
 
 
 def _session(d, seed):
@@ -69,7 +54,7 @@ def test_the_log_has_a_pose_sequence_per_point_and_jumps_over_each_soak(chamber_
         assert q["samples"][0] == p["samples"][1]
         assert 900.0 < data["t"][q["samples"][0]] - data["t"][p["samples"][1] - 1] < 901.0
         np.testing.assert_allclose(np.mean(data["temp"][slice(*p["samples"])]), p["temperature_degC"], atol=0.01)
-    np.testing.assert_allclose(points[2]["accelerometer"], _truth_params(truth, "accelerometer", [TEMPS[2]])[0])
+    np.testing.assert_allclose(points[2]["accelerometer"], truth_params(truth, "accelerometer", [TEMPS[2]])[0])
 
 
 def test_imu_recovers_the_sidecars_temperature_model_within_its_sigma(chamber_cli, tmp_path):
@@ -81,8 +66,8 @@ def test_imu_recovers_the_sidecars_temperature_model_within_its_sigma(chamber_cl
     z = {"accelerometer": [], "gyro": []}
     for _, truth, section in sessions:
         for sensor, keep in (("accelerometer", _LOWER), ("gyro", slice(None))):
-            value, sigma = _smooth(section["thermal"][sensor], temps)
-            z[sensor].append((value - _truth_params(truth, sensor, temps)[:, keep]) / sigma)
+            value, sigma = smooth_at(section["thermal"][sensor], temps)
+            z[sensor].append((value - truth_params(truth, sensor, temps)[:, keep]) / sigma)
     for sensor, zs in z.items():
         zs = np.array(zs)
         rms, m = float(np.sqrt(np.mean(zs**2))), len(sessions) * zs.shape[2] * len(TEMPS)

@@ -1,4 +1,4 @@
-"""A small turntable session over temperature, shared by the tests that run ``gyrocal thermal`` on one."""
+"""Simulated thermal sessions and their truth, shared by the tests of `gyrocal thermal` and `gyrocal imu` across temperature."""
 
 import numpy as np
 
@@ -17,3 +17,19 @@ def thermal_session(path):
     write_csv(path, {"t": rec.t, "gx": d[:, 0], "gy": d[:, 1], "gz": d[:, 2], "temp": rec.temp,
                      "table_rate": np.degrees(rec.table_rate), "axis": rec.axis})
     return path
+
+
+def truth_params(doc, sensor, temps):
+    """Parameters (N, 12) of `sensor` from a simulation sidecar's cubics at `temps` [degC] (heating branch)."""
+    x = (np.asarray(temps) - doc["ref_temp_degC"]) / doc["scale_degC"]
+    return np.vander(x, 4, increasing=True) @ np.asarray(doc[sensor]["coefs"]).T
+
+
+def smooth_at(doc, temps):
+    """Values and 1-sigma (N, m) of a file's smooth model (``accelerometer.thermal.<sensor>``) at `temps`."""
+    sm = doc["smooth"]
+    coefs = np.asarray(sm["coefs"])
+    m, width = coefs.shape
+    powers = np.vander((np.asarray(temps) - sm["centre"]) / sm["scale"], width, increasing=True)
+    cov = np.asarray(sm["covariance"]).reshape(m, width, m, width)
+    return powers @ coefs.T, np.sqrt(np.einsum("np,jpjq,nq->nj", powers, cov, powers))
