@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import contextlib
 import os
-import secrets
 import signal
 import threading
 from pathlib import Path
@@ -83,7 +82,7 @@ def _new_temporary(target: Path) -> Path:
     # Not mkstemp: it makes the file private (0600). O_EXCL keeps the name ours, and the kernel
     # applies the umask to 0666 as for any new file; a replaced file keeps its own mode.
     while True:
-        tmp_path = target.parent / f".{target.name}.{secrets.token_hex(4)}.tmp{target.suffix}"
+        tmp_path = target.parent / f".{target.name}.{os.urandom(4).hex()}.tmp{target.suffix}"
         try:
             os.close(os.open(tmp_path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
             break
@@ -113,7 +112,7 @@ def atomic_folder(path: str | os.PathLike) -> Iterator[Path]:
     target.parent.mkdir(parents=True, exist_ok=True)
     with _cleanup_on_signals():
         while True:
-            tmp = target.parent / f".{target.name}.{secrets.token_hex(4)}.tmp"
+            tmp = target.parent / f".{target.name}.{os.urandom(4).hex()}.tmp"
             try:
                 tmp.mkdir()
                 break

@@ -208,8 +208,9 @@ class _Console(Console):
         os.dup2(devnull, (sys.stderr if self.stderr else sys.stdout).fileno())
 
 
-console = _Console()
-err_console = _Console(stderr=True)
+# no emoji codes: a path such as C:\logs:cube: is printed as written
+console = _Console(emoji=False)
+err_console = _Console(stderr=True, emoji=False)
 _state = {"debug": False}
 
 

@@ -74,10 +74,8 @@ def _windows_from_file(path: Optional[Path], rec):
 
 
 def _example_paths() -> tuple[Path, Path]:
-    from importlib import resources
-
-    data = resources.files("gyrocal") / "data"
-    return Path(str(data / EXAMPLE)), Path(str(data / EXAMPLE_TRUTH))
+    data = Path(__file__).resolve().parents[1] / "data"  # installed as files, never zipped
+    return data / EXAMPLE, data / EXAMPLE_TRUTH
 
 
 def _params_table(run, truth=None):

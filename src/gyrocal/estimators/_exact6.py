@@ -25,7 +25,6 @@ update of ``X`` (Sherman-Morrison), then mapped to ``(k, b)``.
 from __future__ import annotations
 
 import os
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -174,6 +173,8 @@ def exact_six(mean: np.ndarray, rate: np.ndarray, count: np.ndarray, noise_var: 
     starts = range(0, B, _CHUNK)
     n_workers = min(workers or os.cpu_count() or 1, len(starts))
     if n_workers > 1:
+        from concurrent.futures import ThreadPoolExecutor  # only a batch big enough for threads pays its import
+
         with ThreadPoolExecutor(n_workers) as pool:
             chunks = list(pool.map(run, starts))
     else:

@@ -12,6 +12,7 @@ are metadata and skipped.
 from __future__ import annotations
 
 import csv
+import functools
 import re
 from dataclasses import dataclass
 from statistics import median
@@ -168,6 +169,7 @@ def _detect(lines: list[str], content: list[int], fit: _Fit, comma: bool) -> Lay
     """The header: the first line of names followed by a data row. Names right above it are
     kept as other readings (a header over a units row, or metadata of the table's width)."""
 
+    @functools.cache  # judged on demand: a header near the top leaves the thousands of lines below unread
     def is_row(pos: int) -> bool:
         line = lines[content[pos]]  # pandas writes its numbered header first, and only there
         return _is_data(line, fit) and not (pos == 0 and _is_numbered_header(split(line, fit.delimiter)))
@@ -175,10 +177,10 @@ def _detect(lines: list[str], content: list[int], fit: _Fit, comma: bool) -> Lay
     def is_names(pos: int) -> bool:
         return len(split(lines[content[pos]], fit.delimiter)) in (fit.width, fit.width - 1) and not is_row(pos)
 
-    rows = [is_row(pos) for pos in range(len(content))]
-    first = next((pos for pos in range(len(content) - 1) if not rows[pos] and is_names(pos) and rows[pos + 1]), None)
+    first = next((pos for pos in range(len(content) - 1) if not is_row(pos) and is_names(pos) and is_row(pos + 1)),
+                 None)
     if first is None:
-        data = next((pos for pos, row in enumerate(rows) if row), None)
+        data = next((pos for pos in range(len(content)) if is_row(pos)), None)
         if data is None:  # no data row at all: the first line of the table's width is its header
             pos = next((p for p, i in enumerate(content) if len(split(lines[i], fit.delimiter)) == fit.width), 0)
             return _layout_at(lines, content, pos, fit, comma)

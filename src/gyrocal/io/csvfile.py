@@ -1,17 +1,20 @@
 """Delimited text recordings (CSV, TSV, whitespace), read column by column.
 
-Large files go through ``pyarrow.csv`` (multithreaded, columnar), whitespace-separated ones through
-pyarrow's compute kernels (:mod:`._spaced`); without pyarrow a pure-Python reader does the same job
-more slowly.
+A small table of numbers (under a MiB, or any size without pyarrow) goes through numpy's compiled
+``loadtxt``, which parses it before pyarrow could be imported. Larger files go through ``pyarrow.csv``
+(multithreaded, columnar), whitespace-separated ones through pyarrow's compute kernels (:mod:`._spaced`);
+what neither takes (text cells without pyarrow) goes through a pure-Python reader.
 """
 
 from __future__ import annotations
 
 import codecs
 import csv
+import importlib.util
 import io
 import lzma
 import os
+import warnings
 import zlib
 from pathlib import Path
 
@@ -26,6 +29,7 @@ from ._source import arrow_input, compression, open_bytes
 __all__ = ["read_csv_columns", "sniff", "WHITESPACE"]
 
 _HEAD_BYTES = 1 << 16
+_SMALL = 1 << 20  # below a MiB numpy parses a table of numbers faster than pyarrow imports itself
 _DECOMPRESS_ERRORS = (OSError, EOFError, zlib.error, lzma.LZMAError)
 
 
@@ -114,7 +118,8 @@ def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool
         Canonical name -> file column, by name or by number counting from 1 (see
         :func:`gyrocal.io._columns.resolve`). A table without a header needs it.
     use_pyarrow : bool, optional
-        Force (True) or forbid (False) the pyarrow reader; default: when installed.
+        Force (True) or forbid (False) the pyarrow reader; default: numpy's parser for a small table of
+        numbers, else pyarrow when installed.
     skip_rows : int, optional
         Lines above the header (or the first data row) to skip; default: metadata lines are
         found and skipped (see :func:`gyrocal.io._layout.find_layout`).
@@ -136,16 +141,13 @@ def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool
         raise _headerless(path, lines, layout, accel)
     layout, mapping = _mapped(path, lines, layout, columns, accel)
     names = layout.names
+    cols = None
     if use_pyarrow is None:
-        try:
-            import pyarrow.csv  # noqa: F401
-
-            use_pyarrow = True
-        except ImportError:
-            use_pyarrow = False
+        use_pyarrow = importlib.util.find_spec("pyarrow") is not None  # found, not imported: numpy may do
+        if packed is None and (not use_pyarrow or path.stat().st_size <= _SMALL):
+            cols = _read_numbers(path, layout, mapping, encoding)
     try:
-        cols = None
-        if use_pyarrow and len(set(names)) == len(names):
+        if cols is None and use_pyarrow and len(set(names)) == len(names):
             read = _read_arrow if layout.delimiter is not WHITESPACE else _read_spaced
             cols = read(path, packed, layout, mapping, encoding)
         if cols is None:
@@ -162,6 +164,27 @@ def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool
         data["t"] = data["t"] * scale
     extra = {n: cols[n] for n in names if n not in set(mapping.values()) and n in cols}
     return data, extra
+
+
+def _read_numbers(path: Path, layout: Layout, mapping: dict, encoding: str) -> dict | None:
+    """Columns of a plain table whose every column is a mapped number, through numpy's compiled parser
+    (correctly rounded, as pyarrow's); None for anything else (text, empty cells, a ragged row), which
+    the other readers judge and explain."""
+    names = layout.names
+    numeric = {mapping[c] for c in NUMERIC if c in mapping}
+    if layout.decimal_comma or len(set(names)) != len(names) or not set(names) <= numeric:
+        return None
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # "input contained no data" and the like: leave it to the others
+            table = np.loadtxt(path, delimiter=layout.delimiter, skiprows=layout.data, comments=None,
+                               encoding=encoding, ndmin=2)
+    except (ValueError, UserWarning):
+        return None
+    if table.shape[1] != len(names):
+        return None
+    pieces = {n: [table[:, j]] for j, n in enumerate(names)}
+    return _joined(pieces, [mapping[c] for c in ("gx", "gy", "gz")], mapping.get("axis"))
 
 
 def _read_arrow(path: Path, packed: str | None, layout: Layout, mapping: dict, encoding: str) -> dict:
