@@ -281,6 +281,32 @@ def test_installed_entry_point_as_a_subprocess(tmp_path):
     assert len(proc.stderr.strip().splitlines()) == 1
 
 
+def test_entry_point_exit_keeps_output_handlers_threads_and_codes(tmp_path):
+    """The console script ends without the interpreter's teardown (gyrocal.cli._leave). The independent
+    reference is what an ordinary ``sys.exit`` guarantees: all output arrives through a pipe, atexit
+    handlers run, a running non-daemon thread finishes, and the exit code is the command's."""
+    marker = tmp_path / "thread-done"
+    code = ("import atexit, sys, threading, time; import gyrocal.cli; "
+            "atexit.register(lambda: print('atexit ran')); "
+            f"threading.Thread(target=lambda: (time.sleep(0.3), open({str(marker)!r}, 'w').close())).start(); "
+            "sys.argv = ['gyrocal'] + sys.argv[1:]; gyrocal.cli.main()")
+    proc = subprocess.run([sys.executable, "-c", code, "calibrate", "--help"], check=False, capture_output=True,
+                          text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert "Usage" in proc.stdout and proc.stdout.rstrip().endswith("atexit ran")
+    assert marker.exists()
+    # without other threads: the short exit, the same output, handlers and code
+    code = ("import atexit, sys; import gyrocal.cli; atexit.register(lambda: print('atexit ran')); "
+            "sys.argv = ['gyrocal'] + sys.argv[1:]; gyrocal.cli.main()")
+    helped = subprocess.run([sys.executable, "-c", code, "calibrate", "--help"], check=False, capture_output=True,
+                            text=True, timeout=120)
+    assert (helped.returncode, helped.stdout) == (0, proc.stdout)
+    refused = subprocess.run([sys.executable, "-c", code, "calibrate", "--speed", "abc"], check=False,
+                             capture_output=True, text=True, timeout=120)
+    assert refused.returncode == 2 and refused.stdout == "atexit ran\n"
+    assert len(refused.stderr.strip().splitlines()) == 1 and "Traceback" not in refused.stderr
+
+
 def _make_example_module():
     import importlib.util
 

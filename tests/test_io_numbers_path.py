@@ -17,13 +17,14 @@ TABLES = {
     "text column": "t,gx,gy,gz,note\n0.0,1,2,3,a\n0.01,4,5,6,b\n0.02,7,8,9,c\n",
     "empty cell": "t,gx,gy,gz\n0.0,1,2,3\n0.01,,5,6\n0.02,7,8,9\n",
     "metadata above": "# logger v2\nrate: 100 Hz\nt,gx,gy,gz\n0.0,1,2,3\n0.01,4,5,6\n0.02,7,8,9\n",
+    "windows line ends": "t,gx,gy,gz\r\n0.0,1.5,2,3\r\n0.01,4,5,6\r\n0.02,7,8,9.25\r\n",
 }
 
 
 @pytest.mark.parametrize("name", sorted(TABLES))
 def test_default_reader_equals_pyarrow_and_python(tmp_path, name):
     path = tmp_path / "log.csv"
-    path.write_text(TABLES[name])
+    path.write_bytes(TABLES[name].encode())
     default, extra = read_csv_columns(path)
     for forced in (True, False):
         other, other_extra = read_csv_columns(path, use_pyarrow=forced)

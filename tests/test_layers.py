@@ -207,10 +207,29 @@ def test_the_package_imports_without_the_store_extra():
 
 
 def test_the_command_line_starts_without_numpy():
+    """Neither ``import gyrocal.cli`` nor ``gyrocal --help`` (which imports every command module for the
+    commands' summaries) loads numpy or another heavy library."""
     code = ("import sys, gyrocal.cli; heavy = sorted(m for m in ('numpy', 'scipy', 'matplotlib', 'pyarrow', "
-            "'pydantic') if m in sys.modules); print(','.join(heavy))")
+            "'pydantic') if m in sys.modules); print('imported:', ','.join(heavy)); gyrocal.cli.run(['--help']); "
+            "heavy = sorted(m for m in ('numpy', 'scipy', 'matplotlib', 'pyarrow', 'pydantic') if m in sys.modules); "
+            "print('helped:', ','.join(heavy))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True)
-    assert out.stdout.strip() == ""
+    lines = [line.strip() for line in out.stdout.strip().splitlines()]
+    assert lines[0] == "imported:" and lines[-1] == "helped:", out.stdout
+    assert "calibrate" in out.stdout
+
+
+def test_the_bundled_example_calibrates_on_numpy_alone(tmp_path):
+    """``calibrate --example`` loads none of scipy, pyarrow, matplotlib or numpy.ma: numpy's median,
+    percentile and unique would import numpy.ma (a twentieth of the start), and gyrocal._arrays computes
+    the same numbers without (tests/test_arrays_order.py checks them against numpy's)."""
+    code = ("import sys, gyrocal.cli; gyrocal.cli.run(['calibrate', '--example', '-o', sys.argv[1]]); "
+            "heavy = sorted(m for m in ('numpy.ma', 'scipy', 'matplotlib', 'pyarrow') if m in sys.modules); "
+            "print('heavy:', ','.join(heavy))")
+    out = subprocess.run([sys.executable, "-c", code, str(tmp_path / "cal.json")], capture_output=True, text=True,
+                         timeout=120, check=True)
+    assert out.stdout.strip().splitlines()[-1] == "heavy:", out.stdout
+    assert (tmp_path / "cal.json").exists()
 
 
 def _import_graph(sources) -> dict[str, set[str]]:

@@ -14,6 +14,7 @@ import math
 
 import numpy as np
 
+from ._arrays import median
 from .constants import MAD_TO_SIGMA
 
 __all__ = ["difference_variance", "robust_difference_std"]
@@ -31,5 +32,5 @@ def robust_difference_std(d: np.ndarray, axis: int = 0) -> np.ndarray:
     """White-noise standard deviation from first differences `d`, robust to steps and turns: the MAD of the
     differences about their median, as a normal sigma, over sqrt(2)."""
     d = np.asarray(d, dtype=float)
-    centre = np.median(d, axis=axis, keepdims=True)
-    return MAD_TO_SIGMA * np.median(np.abs(d - centre), axis=axis) / math.sqrt(2.0)
+    centre = median(d, axis=axis, keepdims=True)
+    return MAD_TO_SIGMA * median(np.abs(d - centre), axis=axis) / math.sqrt(2.0)

@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._arrays import distinct
+
 __all__ = ["align_vectors", "attitude_change", "attitude_matrices", "from_matrix", "from_rotvec", "matrix_rotvec",
            "multiply", "rotate", "rotvec_matrix", "step_rotvecs", "to_matrix", "to_rotvec"]
 
@@ -159,7 +161,7 @@ def attitude_matrices(t: np.ndarray, omega: np.ndarray, bounds: np.ndarray) -> n
     # (padding then at most doubles the work)
     one_block = len(steps) * steps.max(initial=0) <= 2 * steps.sum() + 4096
     group = np.zeros(len(steps), int) if one_block else np.ceil(np.log2(np.maximum(steps, 1))).astype(int)
-    for g in np.unique(group[steps > 0]):
+    for g in distinct(group[steps > 0]):
         members = np.flatnonzero((group == g) & (steps > 0))
         longest = int(steps[members].max())
         # steps of interval k are phi[first_k : last_k]; shorter ones are padded with identities

@@ -11,7 +11,10 @@ Layer 10 (the command line) of docs/architecture.md: imports the package root an
 
 from __future__ import annotations
 
+import atexit
+import os
 import sys
+import threading
 
 from . import app as _app_module
 from .app import app, run
@@ -41,4 +44,23 @@ _app_module.COMMANDS.update(COMMANDS)
 
 def main() -> None:
     """Console-script entry point."""
-    sys.exit(run(sys.argv[1:]))
+    _leave(run(sys.argv[1:]))
+
+
+def _leave(code: int) -> None:
+    """End the process with `code`, skipping the interpreter's teardown of every module (40-55 ms a run).
+
+    What that teardown does of use happens first: the streams are flushed and the atexit handlers
+    run (logging's among them). Every file gyrocal writes is closed before its command returns. With
+    other threads alive, or a stream that cannot be flushed (a closed pipe), the ordinary exit runs,
+    which waits for the threads and reports the stream as Python does.
+    """
+    try:
+        sys.stdout.flush()
+        sys.stderr.flush()
+    except (OSError, ValueError):
+        sys.exit(code)
+    if threading.active_count() > 1:
+        sys.exit(code)
+    atexit._run_exitfuncs()
+    os._exit(code)

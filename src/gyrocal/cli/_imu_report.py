@@ -104,15 +104,17 @@ def _print_gyro(run) -> None:
 def _print_pairs(g) -> None:
     import numpy as np
 
+    from .._arrays import median
+
     pairs = list(g.checks)
     if not pairs:
         return
     worst = max(pairs, key=lambda c: c.chi2)
     misfit = np.array([c.residual_deg for c in pairs])
     bad = [c.label for c in pairs if c.disagrees]
-    z = np.median([np.sqrt(c.noise_chi2 / (2 if c.kind == "pair" else 3)) for c in pairs])
+    z = median([np.sqrt(c.noise_chi2 / (2 if c.kind == "pair" else 3)) for c in pairs])
     beyond = sum(c.beyond_noise for c in pairs)
-    console.print(f"  turns between poses: {len(pairs)}; misfit median {np.median(misfit):.2g} deg ({z:.2g} times "
+    console.print(f"  turns between poses: {len(pairs)}; misfit median {median(misfit):.2g} deg ({z:.2g} times "
                   f"its noise), largest {worst.residual_deg:.2g} deg ({worst.label}); beyond their noise: {beyond} of "
                   f"{len(pairs)}; " + (f"disagreeing with the others: {', '.join(bad)}" if bad else
                                        "none disagrees with the others")

@@ -177,6 +177,9 @@ app = _Typer(
 )
 
 
+_WIDE = 10_000  # columns: wider than any table gyrocal prints
+
+
 class _Console(Console):
     """rich's console with two changes for a command line whose output users keep.
 
@@ -189,8 +192,10 @@ class _Console(Console):
 
     def print(self, *objects, **kwargs) -> None:
         tables = [o for o in objects if isinstance(o, Table)]
-        wide = self.options.update_width(10_000)
-        need = max((Measurement.get(self, wide, t).maximum for t in tables), default=0)
+        if tables and len(tables) == len(objects) and not any(t.expand for t in tables):
+            need = _WIDE  # alone, a table that does not expand takes its natural width: no need to measure it
+        else:
+            need = max((Measurement.get(self, self.options.update_width(_WIDE), t).maximum for t in tables), default=0)
         if need <= self.width:
             super().print(*objects, **kwargs)
             return

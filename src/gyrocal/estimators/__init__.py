@@ -6,11 +6,12 @@ Each estimator holds only its configuration; ``fit`` returns a frozen
 Layer 4 (the fits) of docs/architecture.md: imports the package root and layers 1 to 4 only.
 """
 
+import sys
+
+from .._lazy import lazy_names
 from ._checks import require_count, require_full_rank
 from ._result import BatchFit, FitResult, Method
-from .algorithm1 import Algorithm1, algorithm1_batch
 from .first_moment import FirstMoment, first_moment_batch
-from .paper_lm import PaperLM, paper_lm_batch
 from .residuals import window_residuals
 
 __all__ = [
@@ -34,7 +35,12 @@ def make_estimator(method: Method, **options):
     """The estimator for a method name: ``first-moment`` (default), ``algorithm1`` or ``lm``."""
     from ..errors import InputError
 
-    table = {"first-moment": FirstMoment, "algorithm1": Algorithm1, "lm": PaperLM}
+    table = {"first-moment": "FirstMoment", "algorithm1": "Algorithm1", "lm": "PaperLM"}
     if method not in table:
         raise InputError(f"{{param}}={method!r} is not one of {', '.join(table)}", param="method", value=method)
-    return table[method](**options)
+    return getattr(sys.modules[__name__], table[method])(**options)  # loads the module of that one alone
+
+
+# the paper's own two fits load on first use: a calibration by the first moment never needs them
+__getattr__, __dir__ = lazy_names(__name__, {"Algorithm1": "algorithm1", "algorithm1_batch": "algorithm1",
+                                             "PaperLM": "paper_lm", "paper_lm_batch": "paper_lm"}, globals())

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._arrays import distinct
 from .._validation import finite_array
 from .._white import robust_difference_std
 from ..errors import InputError
@@ -168,7 +169,7 @@ def fit_sensor(x: np.ndarray, grid: BlockGrid, max_order: int, *, label: str = "
     means = grid.means(x)
     cv = np.full((MAX_ORDER + 1, 3), np.nan)
     cv[: max_order + 1] = segment_cv(grid.u, means, grid.seg, int(max_order))
-    orders = choose_orders(cv[: max_order + 1], len(np.unique(grid.seg)))
+    orders = choose_orders(cv[: max_order + 1], len(distinct(grid.seg)))
     size = grid.size
     d = np.diff(x[: len(x) // size * size].reshape(-1, size, 3), axis=1).reshape(-1, 3)
     noise = robust_difference_std(d)  # white, robust to drift

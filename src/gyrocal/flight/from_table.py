@@ -13,6 +13,7 @@ import warnings
 
 import numpy as np
 
+from .._arrays import median
 from ..errors import GyrocalWarning, InputError
 from ..thermal import ThermalCalibration
 from .thermal_bias import MAX_ORDER, ThermalBias
@@ -63,7 +64,7 @@ def bias_from_thermal(cal: ThermalCalibration) -> ThermalBias:
     residual = np.sqrt(np.mean((sm(cal.temps)[:, _BIAS] - cal.kg[:, _BIAS]) ** 2, axis=0))
     cv = np.zeros((k, 3))
     cv[: sm.loto_rms.shape[0]] = sm.loto_rms[:k, _BIAS]
-    noise = np.zeros(3) if cal.residual_rms is None else np.median(cal.residual_rms, axis=0)
+    noise = np.zeros(3) if cal.residual_rms is None else median(cal.residual_rms, axis=0)
     return ThermalBias(coefs, cov, orders, float(sm.centre), tmin, tmax, cv, residual, noise,
                        sample_rate=float(cal.settings.get("sample_rate", 1.0) or 1.0), duration=0.0,
                        fit={"from": "gyrocal.thermal smooth bias polynomials"},

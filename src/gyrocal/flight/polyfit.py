@@ -15,6 +15,8 @@ import math
 
 import numpy as np
 
+from .._arrays import distinct
+
 __all__ = ["ar1_covariance", "choose_orders", "segment_cv", "vander"]
 
 
@@ -37,7 +39,7 @@ def segment_cv(u: np.ndarray, y: np.ndarray, segments: np.ndarray, max_order: in
     max_order : int
         Highest order tried.
     """
-    labels = np.unique(segments)
+    labels = distinct(segments)
     out = np.empty((max_order + 1, y.shape[1]))
     for p in range(max_order + 1):
         err = np.empty_like(y)

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._arrays import distinct, median
 from ..errors import InputError
 from ..thermal import smooth_temperature
 
@@ -54,7 +55,7 @@ class TemperatureCourse:
 
 
 def _quantum(readings: np.ndarray) -> float | None:
-    levels = np.unique(readings)
+    levels = distinct(readings)
     if len(levels) < 2 or len(levels) > len(readings) / _SAMPLES_PER_LEVEL:
         return None
     q = float(np.min(np.diff(levels)))
@@ -153,7 +154,7 @@ def temperature_course(readings, sample_rate: float, *, median_s: float = 5.0) -
     # median per half-second block, then a running median over blocks: chatter gone, 0.5 s resolution
     size = max(1, int(round(0.5 * sample_rate)))
     nb = len(r) // size
-    blocks = np.median(r[: nb * size].reshape(nb, size), axis=1) if nb else r[:1]
+    blocks = median(r[: nb * size].reshape(nb, size), axis=1) if nb else r[:1]
     blocks = r.min() + np.round((blocks - r.min()) / q) * q  # an even count's median may fall between levels
     level = median_filter(blocks, size=max(3, int(round(median_s / 0.5))) | 1, mode="nearest")
     times, temps, signs = _crossings(level)

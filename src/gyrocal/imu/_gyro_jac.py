@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import quaternion as quat
+from .._arrays import distinct
 from ._gyro_problem import EARTH_RATE, GyroProblem, tangent_basis
 
 __all__ = ["residual_jacobian"]
@@ -92,7 +93,7 @@ def _pair_theta(prob: GyroProblem, a, b, g, with_g: bool):
     group = np.ceil(np.log2(np.maximum(steps, 1))).astype(int)
     rot = np.broadcast_to(np.eye(3), (len(steps), 3, 3)).copy()
     dtheta = np.zeros((len(steps), 3, 21 if with_g else 12))
-    for k in np.unique(group):
+    for k in distinct(group):
         members = np.flatnonzero(group == k)
         rot[members], dtheta[members] = _group_theta(prob.bounds[members], prob, omega, a, b, g, with_g)
     return rot, dtheta

@@ -6,6 +6,7 @@ import numpy as np
 from scipy import stats
 from scipy.optimize import least_squares
 
+from .._arrays import median
 from ..errors import DegenerateDesignError
 from . import _fit
 from ._gyro_cov import noise_model, whitener
@@ -70,7 +71,7 @@ def initial_scale(prob: GyroProblem, bias, directions, directions_std) -> float:
     if not guesses:
         raise DegenerateDesignError("no turn between still poses changes the gravity direction by 20 deg or more, "
                                     "so the gyro scale cannot be found; tilt the board between poses")
-    c0 = float(np.median(guesses))
+    c0 = float(median(guesses))
     grid = c0 * np.exp(np.linspace(np.log(0.5), np.log(4.0), 43))  # 5 % apart
     cost = [np.sum(residuals(prob, "scale", False, np.concatenate([[c, c, c], bias]), directions,
                               directions_std) ** 2) for c in grid]
@@ -140,7 +141,7 @@ def screen_pairs(prob: GyroProblem, p0, directions, directions_std) -> np.ndarra
         return np.einsum("ij,ij->i", r, r)
 
     def robust_scale2(chi2):
-        return max(1.0, float(np.median(chi2)) / stats.chi2.ppf(0.5, 2))
+        return max(1.0, float(median(chi2)) / stats.chi2.ppf(0.5, 2))
 
     p = least_squares(fun, p0, jac=jac, method="trf", x_scale="jac").x
     p = least_squares(fun, p, jac=jac, method="trf", x_scale="jac", loss="cauchy",

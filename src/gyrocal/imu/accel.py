@@ -28,7 +28,7 @@ from typing import Literal, get_args
 import numpy as np
 from scipy.optimize import least_squares
 
-from .._arrays import rows_times
+from .._arrays import median, rows_times
 from .._validation import finite_array, positive
 from ..errors import DegenerateDesignError, InputError
 from ..units import STANDARD_GRAVITY
@@ -196,7 +196,7 @@ def _initial(u: np.ndarray, gravity: float) -> tuple[np.ndarray, np.ndarray]:
             root = np.linalg.cholesky(q / k).T  # root^T root = Q / k: |root (x - c)| = 1 on the ellipsoid
             a, _ = triangular_frame(root * gravity / scale)
             return a, centre + c * scale
-    radius = np.median(np.linalg.norm(u - centre, axis=1))
+    radius = median(np.linalg.norm(u - centre, axis=1))
     return np.eye(3) * gravity / radius, centre
 
 

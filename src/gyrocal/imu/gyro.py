@@ -20,6 +20,7 @@ from typing import Literal, get_args
 import numpy as np
 from scipy import stats
 
+from .._arrays import median
 from ..errors import DegenerateDesignError, InputError
 from . import _fit
 from ._gyro_cov import noise_model
@@ -322,10 +323,10 @@ FAR_BEYOND = 5.0
 def _beyond_noise(checks) -> tuple[str, ...]:
     """One warning when the turns miss far beyond their noise (then none stands out from the others)."""
     z = np.array([math.sqrt(c.noise_chi2 / (2 if c.kind == "pair" else 3)) for c in checks])
-    if not len(z) or not np.median(z) > FAR_BEYOND:
+    if not len(z) or not median(z) > FAR_BEYOND:
         return ()
-    deg = np.median([c.residual_deg for c in checks])
-    return (f"gyro: the turns miss by a median {deg:.2g} deg, {np.median(z):.2g} times their noise, and "
+    deg = median([c.residual_deg for c in checks])
+    return (f"gyro: the turns miss by a median {deg:.2g} deg, {median(z):.2g} times their noise, and "
             f"{sum(c.beyond_noise for c in checks)} of {len(checks)} are beyond it: the gyro did not measure the "
             "turns the poses show (a log glued from parts, lost samples, a wrong rate or unit); do not trust "
             "this result",)

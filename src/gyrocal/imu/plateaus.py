@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._arrays import median
 from .._validation import finite_array, positive
 from ..errors import InputError
 
@@ -46,7 +47,7 @@ def _runs(temp: np.ndarray, start: int, stop: int, tol: float) -> list[tuple[int
     """Cut ``start:stop`` where the temperature leaves ``tol`` of each run's first readings."""
     runs, i = [], start
     while i < stop:
-        ref = float(np.median(temp[i:min(i + _HEAD, stop)]))
+        ref = float(median(temp[i:min(i + _HEAD, stop)]))
         away = np.abs(temp[i:stop] - ref) > tol
         j = stop if not away.any() else i + max(int(np.argmax(away)), 1)
         runs.append((i, j))

@@ -38,6 +38,7 @@ from scipy import stats
 from scipy.ndimage import uniform_filter1d
 from scipy.optimize import least_squares
 
+from .._arrays import distinct, median
 from ..errors import InputError
 from ..thermal.smooth import SmoothModel, loto_errors
 from ..units import STANDARD_GRAVITY
@@ -81,7 +82,7 @@ def is_ramp(t, temp, breaks=(), tol: float = 1.0, window: float = RAMP_WINDOW) -
     drifting = 0
     for a, b in _parts(len(t), breaks):
         chunk = np.floor((t[a:b] - t[a]) / window).astype(int)
-        for k in np.unique(chunk):
+        for k in distinct(chunk):
             sel = np.flatnonzero(chunk == k) + a
             if len(sel) > 2 and abs(_slope(t[sel], temp[sel])) * window > tol:
                 drifting += len(sel)
@@ -331,7 +332,7 @@ def calibrate_ramp(t, gyro, accel, temp, *, gravity: float = STANDARD_GRAVITY, a
     nodes = np.linspace(temps.min(), temps.max(), NODES)
     a_model = sampled(_accel_model(base, fit, base.points[0].results[0].accel.param_names), nodes)
     g_model = sampled(base.gyro, nodes)
-    rate = float(np.median([abs(_slope(t[p.start:p.stop], temp[p.start:p.stop])) for p in bins]) * 60.0)
+    rate = float(median([abs(_slope(t[p.start:p.stop], temp[p.start:p.stop])) for p in bins]) * 60.0)
     notes = list(fit.quality.warnings)
     if np.any(drift > POSE_DRIFT):
         notes.append(f"{int(np.sum(drift > POSE_DRIFT))} of {len(statics)} poses drift by more than "

@@ -19,6 +19,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .._arrays import median
 from ..errors import InputError
 from ..models import KG_INDEX, Affine, ScaleBias
 from ..observations.observed import observe
@@ -105,7 +106,7 @@ def implausible(cal: Calibration) -> str | None:
 def _unit_hint(k: np.ndarray, factor: float, big: str, small: str) -> str:
     """Which unit mix-up a common factor near `factor` (or its inverse) points to: ``big`` is `factor` times
     ``small`` (rad/s = 57.3 deg/s, g = 9.81 m/s^2)."""
-    ratio = float(np.median(k))
+    ratio = float(median(k))
     if abs(ratio / factor - 1) < 0.2:
         return f" (a factor {factor:.3g}: data in {big} read as {small})"
     if abs(ratio * factor - 1) < 0.2:

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
+from .._arrays import median, percentile
 from .._validation import finite_array, positive
 from ..errors import InputError
 from ..units import MAD_TO_SIGMA
@@ -123,7 +124,7 @@ class StaticDetection:
 def _moving(x: np.ndarray, w: int) -> tuple[np.ndarray, np.ndarray]:
     """Centred moving mean and variance (N, 3) over `w` samples (odd), edges repeating the nearest full window."""
     n, h = len(x), w // 2
-    x = x - np.median(x[:: max(1, n // 10000)], axis=0)  # centring keeps the cumulative sums accurate
+    x = x - median(x[:: max(1, n // 10000)], axis=0)  # centring keeps the cumulative sums accurate
     c1 = np.concatenate([np.zeros((1, 3)), np.cumsum(x, axis=0)])
     c2 = np.concatenate([np.zeros((1, 3)), np.cumsum(x * x, axis=0)])
     s1, s2 = (c1[w:] - c1[:-w]) / w, (c2[w:] - c2[:-w]) / w
@@ -150,13 +151,13 @@ def _noise_and_threshold(var: np.ndarray, floor_var: np.ndarray) -> tuple[np.nda
     """Per-axis noise variance, the normalised statistic (N,) and its threshold, from moving variances."""
     var = np.maximum(var, floor_var)
     total = var.sum(axis=1)
-    floor = np.percentile(total, _QUIET_PERCENTILE)
+    floor = percentile(total, _QUIET_PERCENTILE)
     quiet = total <= _QUIET_FACTOR * floor
-    noise = np.median(var[quiet], axis=0)
+    noise = median(var[quiet], axis=0)
     stat = (var / noise).sum(axis=1)
     q = stat[quiet]
-    med = float(np.median(q))
-    spread = MAD_TO_SIGMA * float(np.median(np.abs(q - med))) / max(med, 1e-300)
+    med = float(median(q))
+    spread = MAD_TO_SIGMA * float(median(np.abs(q - med))) / max(med, 1e-300)
     dof = float(np.clip(2.0 / max(spread, 1e-3) ** 2, 1.0, 1e6))
     threshold = med * float(stats.chi2.ppf(1.0 - _FALSE_MOTION, dof)) / dof
     return noise, stat, threshold
@@ -171,8 +172,8 @@ def _near_still_level(mean_g: np.ndarray, quiet: np.ndarray, band: float = 6.0) 
     if quiet.sum() < 3:
         return quiet
     q = mean_g[quiet]
-    level = np.median(q, axis=0)
-    spread = MAD_TO_SIGMA * np.median(np.abs(q - level), axis=0)
+    level = median(q, axis=0)
+    spread = MAD_TO_SIGMA * median(np.abs(q - level), axis=0)
     spread = np.maximum(spread, 1e-9 * max(float(np.abs(q).max()), np.finfo(float).tiny))
     return np.all(np.abs(mean_g - level) <= band * spread, axis=1)
 

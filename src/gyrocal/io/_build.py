@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from .._arrays import distinct, median
 from .._validation import positive
 from .._white import robust_difference_std
 from ..choices import AccelUnit, SaturationPolicy, values
@@ -125,7 +126,7 @@ def _check_accel_units(accel: dict, gravity: float, source: str) -> None:
     if accel.get("accel_units") != "m/s^2":
         return  # counts without a sensitivity have no scale to check
     a = accel["accel"]
-    level = float(np.median(np.linalg.norm(a[:: max(1, len(a) // NOISE_SAMPLES)], axis=1))) / gravity
+    level = float(median(np.linalg.norm(a[:: max(1, len(a) // NOISE_SAMPLES)], axis=1))) / gravity
     if PLAUSIBLE_G[0] <= level <= PLAUSIBLE_G[1]:
         return
     declared = accel["accel_source_units"]
@@ -294,7 +295,7 @@ def build_recording(
         fields = {k: (v[keep] if isinstance(v, np.ndarray) else v) for k, v in fields.items()}
         fields["extra"] = {k: np.asarray(v)[keep] for k, v in extra.items()}
         kept = np.flatnonzero(keep)
-        breaks = tuple(b for b in np.unique(np.searchsorted(kept, breaks)) if 0 < b < len(kept))
+        breaks = tuple(b for b in distinct(np.searchsorted(kept, breaks)) if 0 < b < len(kept))
     return Recording(
         **fields,
         units="counts" if unit == "counts" and sensitivity is None else "rad/s",

@@ -8,12 +8,9 @@ brotli need pyarrow (the ``arrow`` extra).
 
 from __future__ import annotations
 
-import bz2
 import contextlib
-import gzip
-import lzma
+import importlib
 import os
-import zipfile
 from pathlib import Path
 from typing import BinaryIO, Iterator
 
@@ -23,7 +20,8 @@ __all__ = ["compression", "open_bytes", "arrow_input", "COMPRESSIONS"]
 
 #: Compressions read, by the name pyarrow gives them ("xz" and "zip" are read by the standard library only).
 COMPRESSIONS = ("gzip", "bz2", "xz", "zstd", "lz4", "brotli", "zip")
-_STDLIB = {"gzip": gzip.open, "bz2": bz2.open, "xz": lzma.open}
+#: Compression -> the standard-library module whose ``open`` reads it (imported for a compressed file only).
+_STDLIB = {"gzip": "gzip", "bz2": "bz2", "xz": "lzma"}
 _SUFFIXES = {".gz": "gzip", ".gzip": "gzip", ".bz2": "bz2", ".xz": "xz", ".lzma": "xz", ".zst": "zstd",
              ".zstd": "zstd", ".lz4": "lz4", ".br": "brotli", ".zip": "zip"}
 
@@ -55,6 +53,8 @@ def compression(path: str | os.PathLike) -> str | None:
 
 
 def _zip_member(path: Path) -> str:
+    import zipfile
+
     with zipfile.ZipFile(path) as z:
         names = [n for n in z.namelist() if not n.endswith("/") and not n.startswith("__MACOSX/")]
     if len(names) != 1:
@@ -80,11 +80,14 @@ def _need_arrow(path: Path, name: str):
 def open_bytes(path: str | os.PathLike, name: str | None) -> BinaryIO:
     """A binary stream of the file's decompressed content (the file itself when `name` is None)."""
     path = Path(path)
+    if name is None:
+        return open(path, "rb")
+    import lzma
+    import zipfile
+
     try:
-        if name is None:
-            return open(path, "rb")
         if name in _STDLIB:
-            return _STDLIB[name](path, "rb")
+            return importlib.import_module(_STDLIB[name]).open(path, "rb")
         if name == "zip":
             z = zipfile.ZipFile(path)
             return z.open(_zip_member(path))

@@ -177,8 +177,8 @@ def _read_numbers(path: Path, layout: Layout, mapping: dict, encoding: str) -> d
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error")  # "input contained no data" and the like: leave it to the others
-            table = np.loadtxt(path, delimiter=layout.delimiter, skiprows=layout.data, comments=None,
-                               encoding=encoding, ndmin=2)
+            with open(path, encoding=encoding) as f:  # a file, not a path: numpy's decompressors stay unloaded
+                table = np.loadtxt(f, delimiter=layout.delimiter, skiprows=layout.data, comments=None, ndmin=2)
     except (ValueError, UserWarning):
         return None
     if table.shape[1] != len(names):

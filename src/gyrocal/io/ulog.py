@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._arrays import median
 from ..errors import InputError, MissingDependencyError
 
 __all__ = ["read_ulog_columns"]
@@ -69,15 +70,15 @@ def read_ulog_columns(path: str | os.PathLike) -> dict[int, tuple[dict, dict, di
                 "gy": np.asarray(d.data["y"], float)[keep], "gz": np.asarray(d.data["z"], float)[keep]}
         if "temperature" in d.data:
             data["temp"] = np.asarray(d.data["temperature"], float)[keep]
-        dev = int(np.median(d.data["device_id"])) if "device_id" in d.data else None
+        dev = int(median(d.data["device_id"])) if "device_id" in d.data else None
         info = {"device_id": dev, "accel_device_id": None, "duplicates": int(len(us) - len(keep))}
         acc = next((a for a in accels.values() if dev is not None and "device_id" in a.data
-                    and int(np.median(a.data["device_id"])) == dev), accels.get(inst))
+                    and int(median(a.data["device_id"])) == dev), accels.get(inst))
         if acc is not None and len(acc.data["x"]) > 1:
             aus = _stamps(acc)
             akeep = _unique(aus)
             for col, name in (("x", "ax"), ("y", "ay"), ("z", "az")):
                 data[name] = np.interp(data["t"], aus[akeep] * 1e-6, np.asarray(acc.data[col], float)[akeep])
-            info["accel_device_id"] = int(np.median(acc.data["device_id"])) if "device_id" in acc.data else None
+            info["accel_device_id"] = int(median(acc.data["device_id"])) if "device_id" in acc.data else None
         out[int(inst)] = (data, {}, info)
     return out

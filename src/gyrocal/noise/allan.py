@@ -16,6 +16,7 @@ import math
 
 import numpy as np
 
+from .._arrays import distinct
 from .._validation import finite_array, positive
 from ..errors import InputError, MissingDependencyError
 
@@ -60,7 +61,7 @@ def allan_deviation(rates, sample_rate: float, *, points_per_decade: int = 12) -
     if len(w) < MIN_SAMPLES:
         raise InputError(f"a noise analysis needs at least {MIN_SAMPLES} samples at rest, got {len(w)}")
     top = math.log10(len(w) / 9.0)
-    m = np.unique(np.round(np.logspace(0, top, int(top * points_per_decade) + 1)).astype(int))
+    m = distinct(np.round(np.logspace(0, top, int(top * points_per_decade) + 1)).astype(int))
     taus = m / fs
     out = []
     for col in w.T:

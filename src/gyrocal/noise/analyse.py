@@ -13,6 +13,7 @@ import warnings
 
 import numpy as np
 
+from .._arrays import distinct
 from .._validation import finite_array, positive
 from ..choices import MotionPolicy, values
 from ..errors import GyrocalWarning, InputError, UnitError
@@ -45,7 +46,7 @@ def _check_axes(name: str, x: np.ndarray, labels: tuple[str, ...], found: list[s
         if col.min() == col.max():
             raise InputError(f"{name} axis {label} reads {float(col[0]):g} in every sample: a constant column holds "
                              "no noise to analyse (a dead sensor, or the wrong column mapped?)")
-        levels = len(np.unique(col[: 200_000]))
+        levels = len(distinct(col[: 200_000]))
         if levels < _FEW_LEVELS:
             found.append(f"{name} axis {label} takes only {levels} distinct values: quantisation shapes the "
                          "short averaging times, so the density is that of the quantisation steps")

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._arrays import distinct, median
+
 __all__ = ["block_means", "find_lines", "fit_level", "fit_levels", "line_mean", "newey_west_var", "ramp_end",
            "span_variance"]
 
@@ -76,7 +78,7 @@ def span_variance(residuals: list[np.ndarray], *, min_span: int = _MIN_SPAN, spa
     """
     n_min = min(len(r) for r in residuals)
     top = max(min_span + 1, n_min // 3)
-    lengths = np.unique(np.geomspace(min(min_span, max(1, top - 1)), top, spans).astype(int))
+    lengths = distinct(np.geomspace(min(min_span, max(1, top - 1)), top, spans).astype(int))
     k = residuals[0].shape[1]
     rows, values, weights = [], [], []
     for L in lengths.tolist():
@@ -133,7 +135,7 @@ def find_lines(y: np.ndarray, *, max_lines: int = 3, threshold: float = 25.0, mi
         usable = f * n >= min_cycles - 1e-9  # rfftfreq's bin of exactly one cycle can land an ulp short
         if not usable.any():
             break
-        background = np.median(spec[usable]) / np.log(2.0)
+        background = median(spec[usable]) / np.log(2.0)
         i = int(np.flatnonzero(usable)[np.argmax(spec[usable])])
         if spec[i] < threshold * background or i + 1 >= len(spec):
             break

@@ -14,6 +14,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .._arrays import distinct
 from ..errors import InputError
 
 __all__ = ["Moments", "window_moments"]
@@ -117,7 +118,7 @@ def window_moments(x: np.ndarray, starts, stops, t: np.ndarray | None = None) ->
             first = i
         group[i] = first
     parts = []
-    for first in np.unique(group):
+    for first in distinct(group):
         sel = np.flatnonzero(group == first)
         a, b = int(starts[sel[0]]), int(stops[sel[-1]])
         parts.append(_stretch(x[a:b], None if t is None else t[a:b], starts[sel] - a, stops[sel] - a))

@@ -18,6 +18,7 @@ import math
 
 import numpy as np
 
+from .._arrays import median, percentile
 from ..errors import UnitError
 from ..units import unit_factor
 
@@ -47,7 +48,7 @@ def quiet_noise(raw: np.ndarray, sample_rate: float) -> np.ndarray:
         return np.std(raw, axis=0)
     cut = raw[: blocks * size]
     var = np.stack([cut[:, j].reshape(blocks, size).var(axis=1, ddof=1) for j in range(raw.shape[1])], axis=1)
-    quiet = var <= (1.5 * np.sqrt(np.percentile(var, 10, axis=0))) ** 2
+    quiet = var <= (1.5 * np.sqrt(percentile(var, 10, axis=0))) ** 2
     return np.sqrt(np.sum(np.where(quiet, var, 0.0), axis=0) / np.sum(quiet, axis=0))
 
 
@@ -81,7 +82,7 @@ def _ratio(observed, raw: np.ndarray, sample_rate: float, scale: float) -> tuple
     then = np.asarray(observed.get("quiet_noise_std") or observed["noise_std"], dtype=float)
     now = quiet_noise(raw, sample_rate) * abs(scale)
     ok = (then > 0) & (now > 0)  # quantised quiet data can read zero: no evidence
-    return (float(np.median(now[ok] / then[ok])) if ok.any() else math.nan), now, then
+    return (float(median(now[ok] / then[ok])) if ok.any() else math.nan), now, then
 
 
 def _near(ratio: float, factor: float) -> bool:
@@ -132,7 +133,7 @@ def check_observed(observed, raw: np.ndarray, sample_rate: float, *, source: str
         raw = raw * scale  # a warning or a refusal follows: the copy is worth its cost here
     peak_now = np.max(np.abs(raw), axis=0)
     peak_then = np.asarray(observed["max_abs_rate"], dtype=float)
-    r = float(np.median(peak_now / np.where(peak_then > 0, peak_then, np.nan))) if (peak_then > 0).any() else math.nan
+    r = float(median(peak_now / np.where(peak_then > 0, peak_then, np.nan))) if (peak_then > 0).any() else math.nan
     facts = (f"their noise is {_shown(now)} per sample against {_shown(then)} {units} in the calibration's data "
              f"({q:.3g} times), and they reach {_shown(peak_now)} against {_shown(peak_then)} {units}")
     likely = _likely_unit(units, q, r, integers=bool(np.array_equal(raw, np.round(raw))), sensitivity=sensitivity,

@@ -29,6 +29,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from .._arrays import median
 from ..recording import Recording
 from ..segmentation.windows import Window
 from . import Observation, observe_many
@@ -167,7 +168,7 @@ def _plateau_stats(gyro: np.ndarray, blocks: dict, span: dict, plateaus: list[in
             t = clock[span[i][0]:span[i][1]]
             # block centres on the sample clock, in block steps: the median step, which a gap inside the plateau
             # does not stretch (its own mean step would, and put the ripple's phase off)
-            ts.append((t - t[0]) / float(np.median(np.diff(t))))
+            ts.append((t - t[0]) / float(median(np.diff(t))))
     fits = dict(zip(plateaus, fit_levels([blocks[i] for i in plateaus], ts, lines)))
     out: dict[int, dict] = {i: {"level": fits[i][0]} for i in plateaus} if ripple else {}
     if ripple:  # the two readings of a declared speed; weighed once the static windows are known

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._arrays import median
 from ..errors import InputError
 from .calibration import AXIS_COLORS
 from .figure import new_figure, outside_legend
@@ -77,7 +78,7 @@ def plot_overlay(ax, t, test, reference, axis: int, *, units: str, label: str = 
 
 def _running_mean(t: np.ndarray, y: np.ndarray, seconds: float) -> np.ndarray:
     """Centred running mean of `y` over about `seconds` [s] (edges shortened)."""
-    n = max(1, int(round(seconds / max(float(np.median(np.diff(t))), np.finfo(float).tiny))))
+    n = max(1, int(round(seconds / max(float(median(np.diff(t))), np.finfo(float).tiny))))
     c = np.concatenate([[0.0], np.cumsum(y)])
     lo = np.clip(np.arange(len(y)) - n // 2, 0, len(y))
     hi = np.clip(np.arange(len(y)) + n - n // 2, 0, len(y))

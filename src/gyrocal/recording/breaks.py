@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._arrays import median
+
 __all__ = ["BACK_PERIODS", "BREAK_PERIODS", "BREAK_S", "COUNTER_NAMES", "MIN_PART", "counter_breaks",
            "describe_breaks", "find_counter", "join_backward_parts", "spans_break", "split_spans"]
 
@@ -66,7 +68,7 @@ def join_backward_parts(t: np.ndarray, period: float | None = None) -> tuple[np.
     if len(step) < 2 * MIN_PART or not (step <= 0).any():
         return None
     forward = step[step > 0]
-    period = period or (float(np.median(forward)) if len(forward) else 0.0)
+    period = period or (float(median(forward)) if len(forward) else 0.0)
     cut = np.flatnonzero(step < -BACK_PERIODS * period)
     if period <= 0 or not len(cut) or np.count_nonzero(step <= 0) != len(cut):
         return None

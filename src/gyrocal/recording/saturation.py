@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._arrays import median
 from .._validation import positive
 from ..errors import InputError
 
@@ -81,7 +82,7 @@ def stuck_runs(g: np.ndarray, hi: np.ndarray, lo: np.ndarray, min_run: int = MIN
     mask = np.zeros(g.shape, dtype=bool)
     for j in range(3):
         col = g[:, j]
-        median = None
+        typical = None
         # each extreme on its own: a run stuck at +32767 counts even when one sample reads -32768
         for level in {hi[j], lo[j]}:  # a set: one pass for a constant axis
             if not np.isfinite(level) or level == 0:
@@ -91,7 +92,7 @@ def stuck_runs(g: np.ndarray, hi: np.ndarray, lo: np.ndarray, min_run: int = MIN
                 continue
             runs = _long_runs(stuck, min_run)
             if runs.any() and _piles_up(col, level, np.count_nonzero(stuck), level == hi[j]):
-                median = np.median(np.abs(col)) if median is None else median  # a sort: only when needed
-                if abs(level) > 2.0 * median:
+                typical = median(np.abs(col)) if typical is None else typical  # a sort: only when needed
+                if abs(level) > 2.0 * typical:
                     mask[:, j] |= runs
     return mask

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._arrays import median
 from ..errors import InputError
 from .breaks import BREAK_PERIODS, BREAK_S, describe_breaks
 from .timegaps import LATE_STEP as _LATE_STEP
@@ -54,7 +55,7 @@ def nominal_period(t: np.ndarray) -> float:
     if n < 2 * block:
         return float(t[-1] - t[0]) / n
     ends = t[::block]
-    return float(np.median(np.diff(ends))) / block
+    return float(median(np.diff(ends))) / block
 
 
 @dataclass(frozen=True)
@@ -298,7 +299,7 @@ def analyse_time(t, *, has_time: bool = True, breaks=()) -> TimeBase:
         span=float(t[-1] - t[0]),
         period=period,
         mean_step=float(t[-1] - t[0]) / (len(t) - 1),
-        median_step=float(np.median(sample)),
+        median_step=float(median(sample)),
         jitter=float(sample.std()) if len(sample) > 1 else 0.0,
         delayed=_late(t, longest, sample, period, gaps),
         gaps=tuple(gaps),
@@ -325,7 +326,7 @@ def _late(t: np.ndarray, longest: float, sample: np.ndarray, period: float, gaps
     not a delivery held up. `sample` is an even spread of the steps (the packets' step is their
     median above half a period).
     """
-    packet = float(np.median(sample[sample > 0.5 * period])) if np.any(sample > 0.5 * period) else period
+    packet = float(median(sample[sample > 0.5 * period])) if np.any(sample > 0.5 * period) else period
     limit = max(_LATE_STEP * period, packet + max(_LATE_EXTRA * period, _LATE_HOLD))
     if longest <= limit:
         return 0

@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._arrays import distinct
+
 __all__ = ["CANDIDATE_STEP", "LATE_STEP", "Found", "Gap", "find_gaps", "least_delayed", "residual"]
 
 #: Steps below this multiple of the period cannot hide a lost sample and are not examined.
@@ -61,7 +63,7 @@ def _candidates(t: np.ndarray, period: float, floor: np.ndarray, size: int) -> n
         return np.empty(0, dtype=np.int64)
     n = len(t)
     spans = [(int(a) * size, min(n - 1, (int(a) + 2) * size)) for a in rise]
-    likely = np.unique(np.concatenate(
+    likely = distinct(np.concatenate(
         [a + np.flatnonzero(t[a + 1:b + 1] - t[a:b] > CANDIDATE_STEP * period) for a, b in spans]))
     step = t[likely + 1] - t[likely]
     long_first = likely[step >= LATE_STEP * period]

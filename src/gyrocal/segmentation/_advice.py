@@ -12,6 +12,8 @@ import math
 
 import numpy as np
 
+from .._arrays import median
+
 __all__ = ["advise", "measured_turns"]
 
 _DEG = math.degrees(1.0)
@@ -44,7 +46,7 @@ def _common(values: list[float]) -> float | None:
     v = np.abs(np.asarray([x for x in values if math.isfinite(x) and x != 0]))
     if len(v) == 0:
         return None
-    med = float(np.median(v))
+    med = float(median(v))
     return med if np.all(np.abs(v / med - 1) <= 0.25) else None
 
 

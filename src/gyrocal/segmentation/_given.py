@@ -19,6 +19,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from .._arrays import median
 from ..errors import InputError
 from ._measure import measure_turn, standstill_level
 from ._result import Segmentation
@@ -41,7 +42,7 @@ def _name(i: int, w: Window) -> str:
 def _require_constant_speed(samples: np.ndarray, w: Window, i: int) -> None:
     """Refuse a window with ramps: the speed reference holds only on the constant-speed part."""
     tenths = np.linalg.norm([part.mean(axis=0) for part in np.array_split(samples, min(10, len(samples)))], axis=1)
-    middle = float(np.median(tenths))
+    middle = float(median(tenths))
     worst = float(min(tenths[0], tenths[-1]))
     if worst < (1 - _SPEED_SPREAD) * middle:
         raise InputError(
@@ -119,7 +120,7 @@ def contradicted(windows: Sequence[Window], measured: Sequence[float], *, physic
         mine = [i for i in rot if windows[i].axis == a]
         for i in mine if len(mine) >= 3 else ():
             others = np.array([logk[j] for j in mine if j != i])
-            centre = float(np.median(others))
+            centre = float(median(others))
             if abs(logk[i] - centre) > tol and np.all(np.abs(others - centre) <= tol):
                 blamed.add(i)
                 why = (f"k {math.exp(logk[i]):.3g} where the other {len(others)} {a} turns imply {math.exp(centre):.3g}: "
@@ -134,7 +135,7 @@ def contradicted(windows: Sequence[Window], measured: Sequence[float], *, physic
             ref, what = 0.0, "1"
         else:  # counts: one full-scale setting for the chip, so the other axes' k
             other = [logk[i] for i in rot if windows[i].axis != a and i not in blamed]
-            ref, what = (float(np.median(other)), "the other axes' k") if other else (math.nan, "")
+            ref, what = (float(median(other)), "the other axes' k") if other else (math.nan, "")
         near = [i for i in mine if math.isfinite(ref) and abs(logk[i] - ref) <= math.log1p(PLAUSIBLE)]
         listing = ", ".join(f"{_name(i, windows[i])} declared {math.degrees(windows[i].angle):g} deg implies k "
                             f"{math.exp(logk[i]):.3g}" for i in mine)
@@ -142,7 +143,7 @@ def contradicted(windows: Sequence[Window], measured: Sequence[float], *, physic
         if near and far and np.ptp([logk[i] for i in near]) <= tol:
             for i in far:
                 why = (f"k {math.exp(logk[i]):.3g} where the other {a} turn{'s imply' if len(near) > 1 else ' implies'} "
-                       f"{math.exp(np.median([logk[j] for j in near])):.3g}; with so few turns neither outvotes the "
+                       f"{math.exp(median([logk[j] for j in near])):.3g}; with so few turns neither outvotes the "
                        f"other, and this k is more than {100 * PLAUSIBLE:.0f} % from {what}: left out")
                 leave(i, why)
             continue

@@ -11,6 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._arrays import median, percentile
+
 __all__ = ["Motion", "detect_motion", "runs_of", "static_level"]
 
 _MAX_STATS = 1_000_000  # samples enough for a quantile; more only costs time
@@ -173,12 +175,12 @@ def static_level(gyro: np.ndarray, block: int) -> tuple[np.ndarray, np.ndarray, 
     """
     n = len(gyro) // block
     if n < 1:
-        return np.median(gyro, axis=0), gyro.std(axis=0), 0.0
+        return median(gyro, axis=0), gyro.std(axis=0), 0.0
     mean, std = _block_stats(np.asarray(gyro, dtype=float), block, n)
     quiet = _quiet_blocks(std)
     m, s = mean[quiet], std[quiet]
     sq = np.einsum("ij,ij->i", m, m)
-    radius = 6.0 * float(np.linalg.norm(np.median(s, axis=0))) / np.sqrt(block) + 1e-12 * float(np.sqrt(sq.max()))
+    radius = 6.0 * float(np.linalg.norm(median(s, axis=0))) / np.sqrt(block) + 1e-12 * float(np.sqrt(sq.max()))
     # compared pairwise: the quiet blocks nearest zero (standstill's among them), at most _MAX_CLUSTER
     near = np.argsort(sq, kind="stable")[:_MAX_CLUSTER]
     count, _ = _neighbours(m[near], radius)
@@ -187,11 +189,11 @@ def static_level(gyro: np.ndarray, block: int) -> tuple[np.ndarray, np.ndarray, 
     # its members among all quiet blocks, re-centred once: the block nearest zero is on the cluster's edge
     for _ in range(2):
         members = np.flatnonzero(np.einsum("ij,ij->i", m - centre, m - centre) < radius * radius)
-        centre = np.median(m[members], axis=0)
-    base, sd = centre, np.median(s[members], axis=0)
+        centre = median(m[members], axis=0)
+    base, sd = centre, median(s[members], axis=0)
     # Bias drift between pauses: the spread of the standstill levels beyond what noise explains
     # (the 90th percentile of a 3-d normal's radius is about 2.5 sigma).
-    p90 = float(np.percentile(np.linalg.norm(m[members] - base, axis=1), 90))
+    p90 = float(percentile(np.linalg.norm(m[members] - base, axis=1), 90))
     drift = max(0.0, p90 - 2.5 * float(np.sqrt(np.mean(sd**2) / block)))
     return base, sd, drift
 
@@ -220,7 +222,7 @@ def detect_motion(gyro: np.ndarray, sample_rate: float, *, smooth_s: float = 0.1
     low = nsigma * float(np.sqrt(np.sum(sd**2) / w)) + 2.0 * spread
     sub = level[:: max(1, N // _MAX_STATS)]
     strong = sub[sub > 2 * low]
-    high = max(2 * low, 0.2 * float(np.median(strong))) if len(strong) else np.inf
+    high = max(2 * low, 0.2 * float(median(strong))) if len(strong) else np.inf
     above = level > low
     busy = runs_of(above)
     core = np.concatenate(([0], np.cumsum(level > high)))

@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 
+from .._arrays import median
 from ._motion import Motion, runs_of
 from ._result import NO_PLATEAU
 from ._select import AGREE_TOL, K_RANGE, select_by_axis
@@ -88,7 +89,7 @@ def speed_turns(view, mo: Motion, speed: float, plateau_tol: float, min_plateau:
     quarter = (s1 - s0) // 4
     level = mo.mean_level(s0 + quarter, s1 - quarter)
     # counts: the declared speed reads as the level of the larger turns (no physical scale)
-    ref = speed if view.units == "rad/s" else float(np.median(level[level >= 0.5 * level.max()]))
+    ref = speed if view.units == "rad/s" else float(median(level[level >= 0.5 * level.max()]))
     st, owner = _plateaus(mo, len(view), level, plateau_tol)
     p0, p1, owner = _trimmed(mo, st, owner, fs, min_plateau)
     mean = mo.mean_level(p0, p1)
@@ -118,7 +119,9 @@ def speed_turns(view, mo: Motion, speed: float, plateau_tol: float, min_plateau:
         ignored.append((Window(int(p0[i]), int(p1[i]), "rotation", "xyz"[ax[i]], int(sg[i]), rate=float(mean[i]),
                                label=label), reason))
     ax, sg, _ = axis_sign(mo.sums(s0, s1))
-    for i in np.setdiff1d(np.arange(len(runs)), owner).tolist():
+    unowned = np.ones(len(runs), dtype=bool)
+    unowned[owner] = False  # the runs that hold no plateau
+    for i in np.flatnonzero(unowned).tolist():
         label = f"{'+' if sg[i] > 0 else '-'}{'xyz'[ax[i]]}"
         ignored.append((Window(int(s0[i]), int(s1[i]), "rotation", "xyz"[ax[i]], int(sg[i]), label=label),
                         f"{NO_PLATEAU}: no {min_plateau:g} s stretch within {100 * plateau_tol:.0f} % of a steady speed"))

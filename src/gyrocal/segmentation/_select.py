@@ -19,6 +19,8 @@ import math
 
 import numpy as np
 
+from .._arrays import median
+
 __all__ = ["K_RANGE", "AGREE_TOL", "select_by_axis"]
 
 #: Scale factors a detected turn may imply: a poor gyro (k 0.5-2.0, the servo paper's extreme study
@@ -78,7 +80,7 @@ def select_by_axis(
             continue
         log = np.log(size[mine])
         anchor = log[np.argmin(np.abs(log - math.log(declared)))]
-        centre = float(np.median(log[np.abs(log - anchor) <= tol]))
+        centre = float(median(log[np.abs(log - anchor) <= tol]))
         agree = np.abs(log - centre) <= tol
         keep[mine[agree]] = True
         for i in mine[~agree]:

@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 
+from .._arrays import median
 from ._motion import Motion
 from ._select import AGREE_TOL, K_RANGE, select_by_axis
 from .windows import Window
@@ -78,7 +79,7 @@ def _counts_scale(runs, v, spread, fs, max_pause, angle) -> float:
     ax, _, off, size, purity = _structural(vec, np.array([spread[g].sum() for g in groups]), 1.0)
     clean = (off <= MAX_OFF_AXIS_DEG) & (purity >= _MIN_PURITY)
     tops = [size[clean & (ax == j)].max() for j in range(3) if np.any(clean & (ax == j))]
-    return float(np.median(tops)) / angle if tops else 1.0
+    return float(median(tops)) / angle if tops else 1.0
 
 
 def _hidden_ramp(mo: Motion, start: int, stop: int) -> tuple[int, int]:
@@ -89,7 +90,7 @@ def _hidden_ramp(mo: Motion, start: int, stop: int) -> tuple[int, int]:
     """
     seg = mo.level[start:stop]
     core = seg[seg > mo.high]
-    half = 0.5 * float(np.median(core)) if len(core) else 0.0
+    half = 0.5 * float(median(core)) if len(core) else 0.0
     if half <= 1.5 * mo.low:  # too weak to read a ramp from
         return 0, 0
     up = np.flatnonzero(seg >= half)

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._arrays import median
 from .._validation import finite_array, positive
 from ..errors import InputError
 from ..units import MAD_TO_SIGMA
@@ -91,11 +92,11 @@ def _moving_blocks(x: np.ndarray, block: int, trend: int, nsigma: float, spread_
 
     mean, spread = _block_stats(x, block)
     dev = mean - median_filter(mean, size=(trend, 1), mode="nearest")
-    typical = np.median(spread, axis=0)
+    typical = median(spread, axis=0)
     # The robust spread of the differences, between a block mean's own white noise (the floor, for
     # quantised or very quiet data) and three times it (so a log that mostly moves cannot widen it).
     floor = typical / np.sqrt(block)
-    scale = np.clip(MAD_TO_SIGMA * np.median(np.abs(dev), axis=0), floor, 3.0 * floor)
+    scale = np.clip(MAD_TO_SIGMA * median(np.abs(dev), axis=0), floor, 3.0 * floor)
     scale = np.maximum(scale, 1e-12 * (np.abs(mean).max() + 1e-300))
     off_trend = np.any(np.abs(dev) > nsigma * scale, axis=1)
     # a step between neighbours (a tilt left in place, a bias jump): the median follows it, a

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._arrays import median, percentile
 from ..simulation.fast import simulate_observations
 from ._common import METHOD_LABELS, PARAM_NAMES, Condition, Progress, ServoSettings, StudyOutput, draw_truth, fit_errors
 from ._crb import crb_std
@@ -61,9 +62,9 @@ def run(
     out.mkdir(parents=True, exist_ok=True)
     rows = []
     for (noise, method), e in errors.items():
-        lo, hi = np.percentile(e, [2.5, 97.5], axis=0)
+        lo, hi = percentile(e, [2.5, 97.5], axis=0)
         for j, name in enumerate(PARAM_NAMES):
-            rows.append([noise, METHOD_LABELS[method], name, float(e[:, j].mean()), float(np.median(e[:, j])),
+            rows.append([noise, METHOD_LABELS[method], name, float(e[:, j].mean()), float(median(e[:, j])),
                          float(e[:, j].std()), float(np.sqrt(np.mean(e[:, j] ** 2))), float(lo[j]), float(hi[j]),
                          float(crb[noise][j])])
     header = ["noise [rad/s]", "method", "param", "mean error", "median error", "std", "rms", "p2.5", "p97.5",

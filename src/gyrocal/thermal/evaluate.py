@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._arrays import distinct
 from ..recording import Recording
 from ..units import unit_factor
 from ._warn import ThermalRangeWarning
@@ -66,7 +67,7 @@ class Evaluation:
         f = unit_factor(units)
         key = np.round(self.steps.temp / resolution) * resolution
         rows = []
-        for t in np.unique(key):
+        for t in distinct(key):
             sel = key == t
             row = {"temp": float(t), "steps": int(sel.sum())}
             for m, e in self.errors.items():

@@ -15,6 +15,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from .._arrays import distinct
 from .._validation import positive
 from ..errors import InputError
 from ..recording import Recording
@@ -271,9 +272,10 @@ def session_steps(recordings: Sequence[Recording], *, settle: float = 2.0, full_
         raise InputError(f"the session turns about {len(axes)} position(s) ({', '.join(AXES[a] for a in axes) or 'none'}); "
                          "the 12-parameter fit needs three, with x, y and z in turn along the table axis")
     keys = _key(steps)
-    every = np.unique(keys)
+    every = distinct(keys)
     for p, temp in enumerate(steps.point_temps):
-        missing = np.setdiff1d(every, keys[steps.point == p])
+        present = set(keys[steps.point == p].tolist())
+        missing = np.array([k for k in every.tolist() if k not in present], dtype=every.dtype)
         if missing.size:
             raise InputError(f"temperature point {temp:.1f} degC is missing {missing.size} rate step(s) that other "
                              f"points have: {_describe_keys(missing)}")

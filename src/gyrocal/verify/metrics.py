@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._arrays import percentile
 from .bootstrap import BlockBootstrap, optimal_block_length
 
 __all__ = ["FIGURES", "Metrics", "error_metrics"]
@@ -74,7 +75,7 @@ def _summary(boot: BlockBootstrap, err: np.ndarray) -> tuple[dict, dict]:
     mse = sq.mean(axis=0)
     mse_b = boot.means(sq)
     absolute = np.abs(err)
-    p99 = np.percentile(absolute, 99.0, axis=0)
+    p99 = percentile(absolute, 99.0, axis=0)
     p99_b = np.stack([boot.quantiles(absolute[:, j], 0.99) for j in range(3)], axis=1)
     return {"mse": mse, "rmse": np.sqrt(mse), "p99": p99}, {"mse": mse_b, "rmse": np.sqrt(mse_b), "p99": p99_b}
 

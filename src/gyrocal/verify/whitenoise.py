@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._arrays import median
 from ..units import MAD_TO_SIGMA
 
 __all__ = ["NoiseEstimate", "second_difference_noise"]
@@ -60,5 +61,5 @@ def second_difference_noise(t: np.ndarray, w: np.ndarray) -> NoiseEstimate:
     h1, h2 = t[1:-1] - t[:-2], t[2:] - t[1:-1]
     lam = (h2 / (h1 + h2))[:, None]  # weight of the previous sample in the straight line
     d = (w[1:-1] - lam * w[:-2] - (1.0 - lam) * w[2:]) / np.sqrt(1.0 + lam**2 + (1.0 - lam) ** 2)
-    std = MAD_TO_SIGMA * np.median(np.abs(d - np.median(d, axis=0)), axis=0)
+    std = MAD_TO_SIGMA * median(np.abs(d - median(d, axis=0)), axis=0)
     return NoiseEstimate(std=std, std_err=std * np.sqrt(_MAD_VARIANCE / len(d)), rms=np.sqrt(np.mean(d * d, axis=0)))
