@@ -2,8 +2,10 @@
 
 Run by hand:  python bench/bench_read_spaced.py [--samples 920000] [--repeat 5]
 
-Writes one servo-like recording (bench_read.servo_signal: t, gx, gy, gz in deg/s at 1 kHz) twice: as
-CSV, and as imu_tk writes its logs (headerless, two spaces before every field). Then:
+Writes one servo-like recording (bench_read.servo_signal: t, gx, gy, gz in deg/s at 1 kHz) three times: as
+CSV, as imu_tk writes its logs (headerless, two spaces before every field: one spacing throughout, read
+by pyarrow's CSV parser with a space as delimiter), and in columns aligned by padding (the spacing varies
+with each number's width: each line split by pyarrow's compute kernels). Then:
 
 * time: ``read_recording`` of each, taking turns within each of `repeat` rounds in this process;
   the medians of wall and CPU time, and spaced / CSV. The pure-Python reader the spaced file went
@@ -36,7 +38,7 @@ def _read(kind: str, path: Path):
 
     if kind == "csv":
         return read_recording(path, units="deg/s")
-    if kind == "spaced":
+    if kind in ("spaced", "aligned"):
         return read_recording(path, units="deg/s", columns=_COLUMNS)
     return read_csv_columns(path, _COLUMNS, use_pyarrow=False)
 
@@ -80,11 +82,12 @@ def main() -> None:
 
     data = servo_signal(args.samples, 1000.0, np.random.default_rng(1))
     with tempfile.TemporaryDirectory() as tmp:
-        paths = {"csv": Path(tmp) / "servo.csv", "spaced": Path(tmp) / "servo.txt"}
+        paths = {"csv": Path(tmp) / "servo.csv", "spaced": Path(tmp) / "servo.txt", "aligned": Path(tmp) / "aligned.txt"}
         write_csv(paths["csv"], data)
         cols = np.column_stack([data[c] for c in ("t", "gx", "gy", "gz")])
         np.savetxt(paths["spaced"], cols, fmt="  %.6f  %.9g  %.9g  %.9g")
-        kinds = ["csv", "spaced"] + (["python"] if args.python else [])
+        np.savetxt(paths["aligned"], cols, fmt="%12.6f %16.9g %16.9g %16.9g")
+        kinds = ["csv", "spaced", "aligned"] + (["python"] if args.python else [])
         paths["python"] = paths["spaced"]
         times = {k: ([], []) for k in kinds}
         for _ in range(args.repeat):

@@ -95,3 +95,47 @@ def test_header_only_and_utf16(tmp_path, rng):
     (tmp_path / "u16.txt").write_bytes(text.encode("utf-16"))
     data, _ = _both(tmp_path / "u16.txt")
     np.testing.assert_array_equal(data["gz"], rows[:, 3])
+
+
+def _imu_tk(rows) -> str:
+    return "".join(f"  {t:.6f}  {x:.9g}  {y:.9g}  {z:.9g}\n" for t, x, y, z in rows)
+
+
+def test_one_spacing_throughout_takes_the_multithreaded_parser(tmp_path, rng, monkeypatch):
+    """imu_tk's two spaces before each field: read by pyarrow's CSV parser with a space as delimiter
+    (the line-splitting route is not called), to the same bits as the Python reader."""
+    import gyrocal.io._spaced as spaced
+
+    rows = _rows(rng, 3000)
+    path = tmp_path / "gyro.txt"
+    path.write_text(_imu_tk(rows))
+
+    def not_called(*args, **kwargs):
+        raise AssertionError("the line-splitting route read a file of one spacing")
+
+    monkeypatch.setattr(spaced, "spaced_pieces", not_called)
+    data, _ = _both(path, "t=1,gx=2,gy=3,gz=4")
+    np.testing.assert_allclose(data["gx"], rows[:, 1], rtol=1e-8)  # written with 9 digits
+
+
+@pytest.mark.parametrize("late, message", [
+    ("  9.000000 1 2 3\n", None),  # other spacing: the line-splitting route reads it all
+    ("5  9.000000  1  2  3\n", r"has 5 fields, the header has 4"),  # a field in a gap
+    ("  9.000000  1    3\n", r"has 3 fields, the header has 4"),  # a field missing
+    ("nan  9.000000  1  2  3\n", r"has 5 fields, the header has 4"),  # "nan" in a gap is a field too
+])
+def test_a_line_past_the_sample_that_departs_from_its_spacing(tmp_path, rng, late, message):
+    """Beyond the first 64 KiB the parser's delimiter meets a line of other spacing: the table is read by
+    the line-splitting route, with the same numbers and the same refusals as the Python reader."""
+    rows = _rows(rng, 3000)
+    text = _imu_tk(rows)
+    assert len(text.encode()) > 2 * 65536
+    path = tmp_path / "gyro.txt"
+    path.write_text(text + late + _imu_tk(rows[:5]))
+    if message is None:
+        data, _ = _both(path, "t=1,gx=2,gy=3,gz=4")
+        assert len(data["t"]) == 3006 and data["t"][3000] == 9.0
+        return
+    for use_pyarrow in (True, False):
+        with pytest.raises(InputError, match=message):
+            read_csv_columns(path, "t=1,gx=2,gy=3,gz=4", use_pyarrow=use_pyarrow)

@@ -1,13 +1,19 @@
 """Whitespace-separated text tables (imu_tk's and mikoff's ``time x y z``) through pyarrow's compiled kernels.
 
-pyarrow's CSV parser takes one delimiter and does not collapse runs of them, so each line is read
-whole (as the one column of a table delimited by a control character no text log holds), then
-trimmed, split on runs of spaces and tabs, and cast to numbers by pyarrow's compute kernels: the
-same parse of the same cells as the CSV reader's, without a Python string per cell.
+pyarrow's CSV parser takes one delimiter and does not collapse runs of them. Where every line has
+the same spacing (imu_tk writes two spaces before each field), the parser reads the file with that
+one character as its delimiter, on every core, the empty cells between fields as columns that must
+stay empty (:func:`regular_table`). Otherwise each line is read whole (as the one column of a table
+delimited by a control character no text log holds), then trimmed, split on runs of spaces and
+tabs, and cast to numbers by pyarrow's compute kernels (:func:`spaced_pieces`). Both are the same
+parse of the same cells as the CSV reader's, without a Python string per cell.
 """
 
 from __future__ import annotations
 
+import os
+from collections import deque
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -20,13 +26,55 @@ from ._arrow import from_numpy, numeric_to_numpy, text_to_numpy
 from ._layout import Layout
 from ._source import arrow_input
 
-__all__ = ["spaced_pieces"]
+__all__ = ["regular_table", "spaced_pieces"]
 
 _LINE_DELIMITER = "\x1f"  # ASCII unit separator: never in a text log, so a whole line is one cell
 
 
+def _spacing(lines: list[str], width: int) -> tuple[str, int, list[int]] | None:
+    """The one separator character, the cells per line and the places of the `width` fields that every
+    sampled line shares; None when the spacing varies (columns aligned by padding, tabs and spaces mixed)."""
+    for sep in (" ", "\t"):
+        shapes = {(len(cells), tuple(i for i, c in enumerate(cells) if c))
+                  for line in lines if line and (cells := line.split(sep))}
+        if len(shapes) == 1:
+            count, fields = shapes.pop()
+            if len(fields) == width and all(len(line.split()) == width for line in lines if line):
+                return sep, count, list(fields)
+    return None
+
+
+def regular_table(path: Path, packed: str | None, layout: Layout, lines: list[str], encoding: str):
+    """The table's columns as float64 (a pyarrow table, named as `layout`), read by the multithreaded
+    CSV parser when the sampled data `lines` share one spacing; None otherwise, and wherever a later
+    line departs from it (a cell between fields not empty, or a field empty), which the caller then
+    reads by :func:`spaced_pieces`."""
+    spacing = _spacing(lines, len(layout.names))
+    if spacing is None:
+        return None
+    sep, count, fields = spacing
+    names = [f"_{i}" for i in range(count)]  # every cell; the empty ones between fields typed null
+    for i, name in zip(fields, layout.names):
+        names[i] = name
+    types = {n: pa.float64() if i in fields else pa.null() for i, n in enumerate(names)}
+    options = {
+        "read_options": pcsv.ReadOptions(skip_rows=layout.data, column_names=names,
+                                         encoding="utf8" if encoding == "utf-8-sig" else encoding),
+        "parse_options": pcsv.ParseOptions(delimiter=sep, quote_char=False, ignore_empty_lines=True),
+        # only an empty cell is null: a gap holding "nan" is a field too many, a field reading "NA" no number here
+        "convert_options": pcsv.ConvertOptions(column_types=types, null_values=[""], strings_can_be_null=False),
+    }
+    try:
+        with arrow_input(path, packed) as source:
+            table = pcsv.read_csv(source, **options).select(layout.names)
+    except pa.ArrowInvalid:  # a line of other spacing, or a cell that is not a number
+        return None
+    return None if any(column.null_count for column in table.columns) else table
+
+
 def _lines(path: Path, packed: str | None, layout: Layout, encoding: str) -> list:
-    """The data lines, as pyarrow string chunks (empty lines dropped)."""
+    """The data lines, as pyarrow string chunks (empty lines dropped), read on every core (the streaming
+    reader, on one, holds as much memory ahead of the blocks it has given)."""
     options = {
         "read_options": pcsv.ReadOptions(skip_rows=layout.data, column_names=["line"], encoding=encoding),
         "parse_options": pcsv.ParseOptions(delimiter=_LINE_DELIMITER, quote_char=False, ignore_empty_lines=True),
@@ -36,17 +84,17 @@ def _lines(path: Path, packed: str | None, layout: Layout, encoding: str) -> lis
         return pcsv.read_csv(source, **options).column(0).chunks
 
 
-def _cells(chunk, width: int, row0: int, source: str) -> tuple[pa.Array, int]:
-    """The cells of a chunk of lines, row after row, and how many rows it holds; blank lines are no rows."""
+def _cells(chunk, width: int) -> tuple[pa.Array, int, tuple[int, int] | None]:
+    """The cells of a chunk of lines, row after row, how many rows it holds (blank lines are no rows),
+    and the first row of another width than `width` (its index in the chunk and its fields), if any."""
     chunk = pc.ascii_trim_whitespace(chunk)
     if pc.any(pc.equal(pc.binary_length(chunk), 0)).as_py():
         chunk = pc.filter(chunk, pc.greater(pc.binary_length(chunk), 0))  # lines of spaces only
     split = pc.ascii_split_whitespace(chunk)
     counts = numeric_to_numpy(pc.list_value_length(split), copy=False)
     if len(counts) and (bad := np.flatnonzero(counts != width)).size:
-        i = int(bad[0])
-        raise InputError(f"{source}: data row {row0 + i + 1} has {int(counts[i])} fields, the header has {width}")
-    return pc.list_flatten(split), len(chunk)
+        return split, len(chunk), (int(bad[0]), int(counts[bad[0]]))
+    return pc.list_flatten(split), len(chunk), None
 
 
 def _columns(cells: pa.Array, rows: int, names: list[str], numeric: set[str], axis: str | None) -> dict:
@@ -79,19 +127,43 @@ def spaced_pieces(path: Path, packed: str | None, layout: Layout, numeric: list[
     # pyarrow reads UTF-8 (its BOM included) natively and transcodes anything else
     encoding = "utf8" if encoding == "utf-8-sig" else encoding
     try:
-        chunks = _lines(path, packed, layout, encoding)
+        return _pieces(_lines(path, packed, layout, encoding), path.name, layout.names, set(numeric), axis)
     except pa.ArrowInvalid as exc:
         if "invalid UTF8" not in str(exc) or encoding != "utf8":
             return None
-        chunks = _lines(path, packed, layout, "latin-1")  # text from an older logger: every byte is a character
-    names = layout.names
+    # text from an older logger: every byte is a character
+    return _pieces(_lines(path, packed, layout, "latin-1"), path.name, layout.names, set(numeric), axis)
+
+
+def _pieces(chunks: list, source: str, names: list[str], numeric: set[str], axis: str | None) -> dict[str, list]:
+    """The chunks of lines split and cast on every core (the kernels release the GIL), a few chunks ahead
+    of the one whose numbers are collected, in order (so a bad row is named by its number in the file);
+    each chunk of lines goes once its numbers are out."""
+
+    def columns(chunk):
+        cells, rows, bad = _cells(chunk, len(names))
+        return ({} if bad or not rows else _columns(cells, rows, names, numeric, axis)), rows, bad
+
     pieces: dict[str, list] = {n: [] for n in names}
     row = 0
-    for i in range(len(chunks)):
-        chunk, chunks[i] = chunks[i], None  # each chunk of lines goes once its numbers are out
-        cells, rows = _cells(chunk, len(names), row, path.name)
+
+    def collect(future) -> None:
+        nonlocal row
+        cols, rows, bad = future.result()
+        if bad:
+            raise InputError(f"{source}: data row {row + bad[0] + 1} has {bad[1]} fields, the header has {len(names)}")
         row += rows
-        if rows:
-            for n, piece in _columns(cells, rows, names, set(numeric), axis).items():
-                pieces[n].append(piece)
+        for n, piece in cols.items():
+            pieces[n].append(piece)
+
+    workers = os.cpu_count() or 1
+    with ThreadPoolExecutor(workers) as pool:
+        pending: deque = deque()
+        chunks.reverse()
+        while chunks:
+            pending.append(pool.submit(columns, chunks.pop()))
+            if len(pending) > workers:
+                collect(pending.popleft())
+        while pending:
+            collect(pending.popleft())
     return pieces

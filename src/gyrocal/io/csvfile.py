@@ -148,8 +148,10 @@ def read_csv_columns(path: str | os.PathLike, columns=None, *, use_pyarrow: bool
             cols = _read_numbers(path, layout, mapping, encoding)
     try:
         if cols is None and use_pyarrow and len(set(names)) == len(names):
-            read = _read_arrow if layout.delimiter is not WHITESPACE else _read_spaced
-            cols = read(path, packed, layout, mapping, encoding)
+            if layout.delimiter is WHITESPACE:
+                cols = _read_spaced(path, packed, layout, mapping, encoding, lines[layout.data:])
+            else:
+                cols = _read_arrow(path, packed, layout, mapping, encoding)
         if cols is None:
             cols = _read_python(path, packed, layout, encoding)
     except _DECOMPRESS_ERRORS as exc:
@@ -272,17 +274,24 @@ def _filled(table, names: list[str], rates: list[str]) -> dict[str, np.ndarray]:
     return cols
 
 
-def _read_spaced(path: Path, packed: str | None, layout: Layout, mapping: dict, encoding: str) -> dict | None:
-    """Columns of a whitespace-separated table through pyarrow; None where it cannot read the lines."""
+def _read_spaced(path: Path, packed: str | None, layout: Layout, mapping: dict, encoding: str,
+                 sample: list[str]) -> dict | None:
+    """Columns of a whitespace-separated table through pyarrow (`sample`: its first data lines); None
+    where it cannot read the lines."""
     import pyarrow as pa
 
-    from ._spaced import spaced_pieces
+    from ._spaced import regular_table, spaced_pieces
 
+    rates = [mapping[c] for c in ("gx", "gy", "gz")]
+    if not layout.decimal_comma and set(layout.names) <= {mapping[c] for c in NUMERIC if c in mapping}:
+        table = regular_table(path, packed, layout, sample, encoding)
+        if table is not None:
+            return _filled(table, layout.names, rates)
     pieces = spaced_pieces(path, packed, layout, [mapping[c] for c in NUMERIC if c in mapping], mapping.get("axis"),
                            encoding)
     if pieces is None:
         return None
-    cols = _joined(pieces, [mapping[c] for c in ("gx", "gy", "gz")], mapping.get("axis"))
+    cols = _joined(pieces, rates, mapping.get("axis"))
     pa.default_memory_pool().release_unused()
     return cols
 
