@@ -139,3 +139,70 @@ def test_a_line_past_the_sample_that_departs_from_its_spacing(tmp_path, rng, lat
     for use_pyarrow in (True, False):
         with pytest.raises(InputError, match=message):
             read_csv_columns(path, "t=1,gx=2,gy=3,gz=4", use_pyarrow=use_pyarrow)
+
+
+def _aligned(rows, end="\n") -> str:
+    """Columns aligned by padding: the runs of spaces vary with each number's width. 64 bytes a line, so
+    lines end exactly where the reader's 1 MiB blocks do."""
+    return "".join(f"{t:12.6f} {x:16.9g} {y:16.9g} {z:16.9g}{end}" for t, x, y, z in rows)
+
+
+def _loadtxt_equal(data, path, skip=0):
+    """numpy's own whitespace parser as a second, independent reference."""
+    ref = np.loadtxt(path, skiprows=skip)
+    for j, c in enumerate(("t", "gx", "gy", "gz")):
+        np.testing.assert_array_equal(data[c], ref[:, j])
+
+
+@pytest.mark.parametrize("end, header", [("\n", ""), ("\r\n", "t gx gy gz\r\n")])
+def test_aligned_columns_over_many_blocks_are_split_into_one_allocation(tmp_path, rng, monkeypatch, end, header):
+    """Varying spacing, 2.5 MiB (blocks end on line ends), a blank line and no newline at the end: split on
+    every core straight into the arrays (the piecewise route is not called), the same bits as the Python
+    reader and numpy.loadtxt; the rates share one (3, N) block."""
+    import gyrocal.io._spaced as spaced
+
+    rows = _rows(rng, 41_000)
+    text = header + _aligned(rows[:20_000], end) + end + _aligned(rows[20_000:], end)
+    path = tmp_path / "aligned.txt"
+    path.write_bytes(text[: -len(end)].encode())
+    assert len(text.encode()) > 2 * (1 << 20)
+
+    def not_called(*args, **kwargs):
+        raise AssertionError("the piecewise route read a table of numbers")
+
+    monkeypatch.setattr(spaced, "spaced_pieces", not_called)
+    data, _ = _both(path, None if header else "t=1,gx=2,gy=3,gz=4")
+    _loadtxt_equal(data, path, skip=1 if header else 0)
+    assert len(data["t"]) == 41_000
+    assert data["gx"].base is not None and data["gx"].base is data["gz"].base
+
+
+@pytest.mark.parametrize("late, message", [
+    ("   9.000000 1 2\n", r"data row 30001 has 3 fields, the header has 4"),
+    ("   9.000000 1 2 3 4\n", r"data row 30001 has 5 fields, the header has 4"),
+    ("   9.000000 1 two 3\n", r"column 'gy' holds non-numeric cell 'two' at data row 30001"),
+])
+def test_aligned_columns_refuse_a_bad_row_by_its_number(tmp_path, rng, late, message):
+    """A bad row in the second MiB is named by its row in the file, as the Python reader names it."""
+    rows = _rows(rng, 40_000)
+    path = tmp_path / "aligned.txt"
+    path.write_text("t gx gy gz\n" + _aligned(rows[:30_000]) + late + _aligned(rows[30_000:]))
+    for use_pyarrow in (True, False):
+        with pytest.raises(InputError, match=message):
+            read_csv_columns(path, use_pyarrow=use_pyarrow)
+
+
+@pytest.mark.parametrize("kind", ["latin-1 note", "bare CR"])
+def test_aligned_columns_the_block_reader_cannot_take_are_read_as_before(tmp_path, rng, kind):
+    """Bytes that are not UTF-8, and old Mac line ends: the block reader declines, the other routes read
+    the file, with the Python reader's numbers."""
+    rows = _rows(rng, 2000)
+    path = tmp_path / "aligned.txt"
+    if kind == "bare CR":
+        path.write_bytes(("t gx gy gz\r" + _aligned(rows, "\r")).encode())
+        data, _ = _both(path)
+    else:
+        path.write_bytes(("t gx gy gz note\n" + _aligned(rows).replace("\n", " caf\xe9\n")).encode("latin-1"))
+        data, extra = read_csv_columns(path)
+        assert set(extra["note"]) == {"caf\xe9"}
+    np.testing.assert_allclose(data["gy"], rows[:, 2], rtol=1e-8)

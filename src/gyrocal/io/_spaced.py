@@ -3,17 +3,16 @@
 pyarrow's CSV parser takes one delimiter and does not collapse runs of them. Where every line has
 the same spacing (imu_tk writes two spaces before each field), the parser reads the file with that
 one character as its delimiter, on every core, the empty cells between fields as columns that must
-stay empty (:func:`regular_table`). Otherwise each line is read whole (as the one column of a table
-delimited by a control character no text log holds), then trimmed, split on runs of spaces and
-tabs, and cast to numbers by pyarrow's compute kernels (:func:`spaced_pieces`). Both are the same
-parse of the same cells as the CSV reader's, without a Python string per cell.
+stay empty (:func:`regular_table`). Otherwise the lines are trimmed, split on runs of spaces and
+tabs and cast to numbers by pyarrow's compute kernels on every core: a plain UTF-8 file of numbers a
+MiB at a time into arrays made once (:func:`spaced_numbers`), anything else as pieces from lines read
+whole, as the one column of a table delimited by a control character no text log holds
+(:func:`spaced_pieces`). All are the same parse of the same cells as the CSV reader's, without a
+Python string per cell.
 """
 
 from __future__ import annotations
 
-import os
-from collections import deque
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -23,10 +22,11 @@ import pyarrow.csv as pcsv
 
 from ..errors import InputError
 from ._arrow import from_numpy, numeric_to_numpy, text_to_numpy
+from ._blocks import in_order, line_blocks, lines_of
 from ._layout import Layout
 from ._source import arrow_input
 
-__all__ = ["regular_table", "spaced_pieces"]
+__all__ = ["regular_table", "spaced_numbers", "spaced_pieces"]
 
 _LINE_DELIMITER = "\x1f"  # ASCII unit separator: never in a text log, so a whole line is one cell
 
@@ -136,9 +136,8 @@ def spaced_pieces(path: Path, packed: str | None, layout: Layout, numeric: list[
 
 
 def _pieces(chunks: list, source: str, names: list[str], numeric: set[str], axis: str | None) -> dict[str, list]:
-    """The chunks of lines split and cast on every core (the kernels release the GIL), a few chunks ahead
-    of the one whose numbers are collected, in order (so a bad row is named by its number in the file);
-    each chunk of lines goes once its numbers are out."""
+    """The chunks of lines split and cast on every core, collected in order (so a bad row is named by its
+    number in the file); each chunk of lines goes once its numbers are out."""
 
     def columns(chunk):
         cells, rows, bad = _cells(chunk, len(names))
@@ -147,23 +146,67 @@ def _pieces(chunks: list, source: str, names: list[str], numeric: set[str], axis
     pieces: dict[str, list] = {n: [] for n in names}
     row = 0
 
-    def collect(future) -> None:
+    def collect(result) -> None:
         nonlocal row
-        cols, rows, bad = future.result()
-        if bad:
-            raise InputError(f"{source}: data row {row + bad[0] + 1} has {bad[1]} fields, the header has {len(names)}")
+        cols, rows, bad = result
+        _refuse(source, row, bad, len(names))
         row += rows
         for n, piece in cols.items():
             pieces[n].append(piece)
 
-    workers = os.cpu_count() or 1
-    with ThreadPoolExecutor(workers) as pool:
-        pending: deque = deque()
-        chunks.reverse()
-        while chunks:
-            pending.append(pool.submit(columns, chunks.pop()))
-            if len(pending) > workers:
-                collect(pending.popleft())
-        while pending:
-            collect(pending.popleft())
+    in_order(_drained(chunks), columns, collect)
     return pieces
+
+
+def _drained(chunks: list):
+    """The items of `chunks` in order, each out of the list as it is given (so it can be freed)."""
+    chunks.reverse()
+    while chunks:
+        yield chunks.pop()
+
+
+def _refuse(source: str, row: int, bad: tuple[int, int] | None, width: int) -> None:
+    if bad:
+        raise InputError(f"{source}: data row {row + bad[0] + 1} has {bad[1]} fields, the header has {width}")
+
+
+def spaced_numbers(path: Path, layout: Layout, rates: list[str]) -> dict[str, np.ndarray] | None:
+    """The columns of a plain UTF-8 whitespace table of numbers only, split and cast on every core a MiB
+    at a time straight into arrays sized from the first blocks (the rates in one (3, N) block): the
+    numbers held about once, not as pieces and then joined. None where this cannot read the file (other
+    bytes, a line ending in a bare CR, a cell that is no number), for :func:`spaced_pieces`."""
+    names = layout.names
+    size = path.stat().st_size
+    order = rates + [n for n in names if n not in rates]  # the rates first: their rows are the (3, N) block
+    where = [names.index(n) for n in order]
+    out = [np.empty((3, 0)), np.empty((len(order) - 3, 0))]  # the rates; the other columns
+    row = seen = 0
+
+    def numbers(block):
+        cells, rows, bad = _cells(lines_of(block), len(names))
+        values = numeric_to_numpy(pc.cast(cells, pa.float64()), copy=False) if rows and not bad else None
+        return values, rows, bad, len(block)
+
+    def store(result) -> None:
+        nonlocal row, seen, out
+        values, rows, bad, length = result
+        _refuse(path.name, row, bad, len(names))
+        seen += length
+        if row + rows > out[0].shape[1]:  # rows per byte so far, over the whole file, and a little more
+            wide = int((row + rows) * size / seen * 1.02) + 1024
+            out = [np.concatenate((part[:, :row], np.empty((len(part), wide - row))), axis=1) for part in out]
+        if rows:
+            table = values.reshape(rows, len(names))[:, where].T
+            out[0][:, row:row + rows], out[1][:, row:row + rows] = table[:3], table[3:]
+            row += rows
+
+    try:
+        in_order(line_blocks(path, layout.data), numbers, store)
+    except InputError:  # a row of another width, named by its number: final
+        raise
+    except (ValueError, pa.ArrowInvalid):  # a bare CR, bytes that are not UTF-8, a cell that is no number
+        return None
+    block = out[0] if row == out[0].shape[1] else out[0][:, :row].copy()  # one (3, N) block of its own
+    others = {n: out[1][j, :row] for j, n in enumerate(order[3:])}
+    del out
+    return {n: block[rates.index(n)] if n in rates else others[n] for n in names}

@@ -280,13 +280,16 @@ def _read_spaced(path: Path, packed: str | None, layout: Layout, mapping: dict, 
     where it cannot read the lines."""
     import pyarrow as pa
 
-    from ._spaced import regular_table, spaced_pieces
+    from ._spaced import regular_table, spaced_numbers, spaced_pieces
 
     rates = [mapping[c] for c in ("gx", "gy", "gz")]
     if not layout.decimal_comma and set(layout.names) <= {mapping[c] for c in NUMERIC if c in mapping}:
         table = regular_table(path, packed, layout, sample, encoding)
         if table is not None:
             return _filled(table, layout.names, rates)
+        cols = spaced_numbers(path, layout, rates) if packed is None and encoding == "utf-8-sig" else None
+        if cols is not None:
+            return cols
     pieces = spaced_pieces(path, packed, layout, [mapping[c] for c in NUMERIC if c in mapping], mapping.get("axis"),
                            encoding)
     if pieces is None:
